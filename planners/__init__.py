@@ -1,0 +1,1 @@
+"""delve.planners"""

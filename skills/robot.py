@@ -1,0 +1,133 @@
+"""The robot interface: everything a skill may ask of a robot.
+
+Skills own this protocol; the simulator implements it (``delve.sim.robot``), and a ROS
+bridge could implement it later without touching a tree or a skill.
+
+Onboard maps use these voxel values: ``UNKNOWN = -1``, ``FREE = 0``, ``OCCUPIED = 1``
+(the same as ``delve.planners.occupancy``).
+"""
+from __future__ import annotations
+
+import enum
+from dataclasses import dataclass
+from typing import Any, Protocol
+
+import numpy as np
+
+
+class PathStatus(enum.Enum):
+    """Where the robot is with its last ``follow_path`` command."""
+
+    IDLE = "idle"
+    FOLLOWING = "following"
+    ARRIVED = "arrived"
+    BLOCKED = "blocked"
+
+
+@dataclass(frozen=True)
+class Mobility:
+    """What a platform can do; planners read these limits."""
+
+    aerial: bool
+    speed_mps: float
+    body_height_m: float
+    radius_m: float
+    max_inclination_deg: float = 90.0
+    max_step_m: float = 0.0
+
+
+class MapView(Protocol):
+    """A robot's onboard occupancy voxel map, built only from its own scans."""
+
+    @property
+    def occupancy(self) -> np.ndarray:
+        """int8 array (nx, ny, nz) of UNKNOWN / FREE / OCCUPIED."""
+
+    @property
+    def origin(self) -> np.ndarray:
+        """World position (m) of the lower corner of voxel (0, 0, 0)."""
+
+    @property
+    def voxel_size_m(self) -> float: ...
+
+    @property
+    def version(self) -> int:
+        """Increases each time the map changes, so planners can cache."""
+
+
+@dataclass(frozen=True)
+class Message:
+    """A radio message: who sent it, to whom, what kind, and its payload."""
+
+    sender: str
+    recipient: str
+    kind: str
+    data: Any
+    sent_s: float
+
+
+class Radio(Protocol):
+    """A robot's (or the base station's) radio. Messages wait in an outbox until a
+    link carries them: nothing sent is lost while the link is down."""
+
+    def send(self, recipient: str, kind: str, data: Any) -> None: ...
+
+    def receive(self) -> list[Message]:
+        """Messages delivered since the last call."""
+
+    def linked_to(self, other: str) -> bool:
+        """Whether a link to ``other`` exists right now."""
+
+    @property
+    def pending(self) -> int:
+        """Messages still waiting in the outbox."""
+
+
+class Robot(Protocol):
+    """A robot as skills see it."""
+
+    @property
+    def name(self) -> str: ...
+
+    @property
+    def platform(self) -> str:
+        """``legged`` or ``aerial``."""
+
+    @property
+    def mobility(self) -> Mobility: ...
+
+    @property
+    def position(self) -> np.ndarray:
+        """(3,) position of the body centre in metres."""
+
+    @property
+    def yaw_rad(self) -> float: ...
+
+    @property
+    def home(self) -> np.ndarray:
+        """(3,) position the robot started from (the base station's side)."""
+
+    @property
+    def onboard_map(self) -> MapView: ...
+
+    @property
+    def endurance_remaining_s(self) -> float: ...
+
+    @property
+    def distance_m(self) -> float:
+        """Distance travelled so far."""
+
+    @property
+    def traversed_path(self) -> np.ndarray:
+        """(N, 3) positions the robot has passed, oldest first."""
+
+    @property
+    def radio(self) -> Radio: ...
+
+    def follow_path(self, path: np.ndarray) -> None:
+        """Start following ``path`` ((N, 3) waypoints); returns at once."""
+
+    def stop(self) -> None: ...
+
+    @property
+    def path_status(self) -> PathStatus: ...
