@@ -1,0 +1,50 @@
+"""Occupancy voxel grids as planners see them: plain numpy arrays.
+
+A grid is an int8 array (nx, ny, nz) with values :data:`UNKNOWN`, :data:`FREE` and
+:data:`OCCUPIED`, an ``origin`` (world position of the lower corner of voxel
+(0, 0, 0)) and a ``voxel_size_m``. These values are the robot interface's
+(``delve.skills.robot``) and the simulator's.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+UNKNOWN = -1
+FREE = 0
+OCCUPIED = 1
+
+
+@dataclass(frozen=True)
+class Grid:
+    """An occupancy array with its placement in the world."""
+
+    occupancy: np.ndarray
+    origin: np.ndarray
+    voxel_size_m: float
+
+    @property
+    def shape(self) -> tuple[int, int, int]:
+        return tuple(self.occupancy.shape)  # type: ignore[return-value]
+
+    def to_index(self, points: np.ndarray) -> np.ndarray:
+        """(N, 3) world points -> (N, 3) integer voxel indices (may be out of bounds)."""
+        return np.floor((np.asarray(points, float) - self.origin) / self.voxel_size_m).astype(np.int64)
+
+    def to_world(self, idx: np.ndarray) -> np.ndarray:
+        """(N, 3) voxel indices -> (N, 3) world positions of the voxel centres."""
+        return self.origin + (np.asarray(idx, float) + 0.5) * self.voxel_size_m
+
+    def in_bounds(self, idx: np.ndarray) -> np.ndarray:
+        idx = np.asarray(idx)
+        return np.all((idx >= 0) & (idx < np.array(self.shape)), axis=-1)
+
+    def value_at(self, points: np.ndarray) -> np.ndarray:
+        """Occupancy at world points; UNKNOWN outside the grid."""
+        idx = self.to_index(np.atleast_2d(points))
+        inside = self.in_bounds(idx)
+        out = np.full(len(idx), UNKNOWN, dtype=np.int8)
+        i = idx[inside]
+        out[inside] = self.occupancy[i[:, 0], i[:, 1], i[:, 2]]
+        return out
