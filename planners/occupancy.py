@@ -5,6 +5,7 @@ A grid is an int8 array (nx, ny, nz) with values :data:`UNKNOWN`, :data:`FREE` a
 (0, 0, 0)) and a ``voxel_size_m``. These values are the robot interface's
 (``delve.skills.robot``) and the simulator's.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass

@@ -2,6 +2,7 @@
 
 Imports ``delve.planners`` only; reaches robots only through :mod:`.robot`.
 """
+
 from __future__ import annotations
 
 import importlib

@@ -5,6 +5,7 @@ parameters in ``PARAMS`` (name -> :class:`Param`, units in the names: ``timeout_
 the executive's loader checks a YAML node against them before it constructs the skill
 with the checked, defaulted values as keyword arguments.
 """
+
 from __future__ import annotations
 
 import math

@@ -6,6 +6,7 @@ bridge could implement it later without touching a tree or a skill.
 Onboard maps use these voxel values: ``UNKNOWN = -1``, ``FREE = 0``, ``OCCUPIED = 1``
 (the same as ``delve.planners.occupancy``).
 """
+
 from __future__ import annotations
 
 import enum
@@ -15,7 +16,7 @@ from typing import Any, Protocol
 import numpy as np
 
 
-class PathStatus(enum.Enum):
+class PathStatus(str, enum.Enum):
     """Where the robot is with its last ``follow_path`` command."""
 
     IDLE = "idle"
@@ -24,16 +25,15 @@ class PathStatus(enum.Enum):
     BLOCKED = "blocked"
 
 
-@dataclass(frozen=True)
-class Mobility:
+class Mobility(Protocol):
     """What a platform can do; planners read these limits."""
 
     aerial: bool
     speed_mps: float
     body_height_m: float
     radius_m: float
-    max_inclination_deg: float = 90.0
-    max_step_m: float = 0.0
+    max_inclination_deg: float
+    max_step_m: float
 
 
 class MapView(Protocol):

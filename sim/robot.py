@@ -1,0 +1,218 @@
+"""Kinematic robots: they follow paths, scan with their LiDAR and never pass through rock.
+
+``SimRobot`` implements the robot interface that skills own (``delve.skills.robot``).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from .platforms import Platform
+from .voxel_map import VoxelMap
+
+if TYPE_CHECKING:
+    from .radio import RadioEndpoint
+    from .world import World
+
+IDLE, FOLLOWING, ARRIVED, BLOCKED = "idle", "following", "arrived", "blocked"
+_GOLDEN = (math.sqrt(5) - 1) / 2
+
+
+class SimRobot:
+    """A legged or aerial robot in a :class:`World`.
+
+    Legged robots keep their body ``body_height_m`` above the ground, refuse steps
+    above ``max_step_m`` and ground inclinations above ``max_inclination_deg``
+    (measured over ``inclination_window_m`` of travel). Aerial robots fly in 3D.
+    Endurance counts down with sim time; at zero the robot stops for good.
+    """
+
+    inclination_window_m = 1.0
+    trail_spacing_m = 0.5
+
+    def __init__(
+        self,
+        name: str,
+        platform: Platform,
+        world: "World",
+        start: np.ndarray,
+        radio: "RadioEndpoint",
+        endurance_s: float | None = None,
+    ):
+        self._name = name
+        self._platform = platform
+        self.world = world
+        self._radio = radio
+        self._map = VoxelMap(world.free.shape, world.origin, world.voxel_size_m)
+        start = np.asarray(start, dtype=float)
+        if platform.aerial:
+            self._ground = math.nan
+            self._pos = start + np.array([0.0, 0.0, platform.body_height_m])
+        else:
+            self._ground = float(start[2])
+            self._pos = start + np.array([0.0, 0.0, platform.body_height_m])
+        self._home = self._pos.copy()
+        self._yaw = 0.0
+        self._endurance = float(endurance_s if endurance_s is not None else platform.endurance_s)
+        self._distance = 0.0
+        self._trail = [self._pos.copy()]
+        self._trail_since = 0.0
+        self._slope_hist: list[tuple[float, float]] = [(0.0, self._ground)]
+        self._path: np.ndarray | None = None
+        self._wp = 0
+        self._status = IDLE
+        self.blocked_reason = ""
+        self._scans = 0
+        self._beams = platform.lidar.beam_directions(0.0)
+
+    # ---- the robot interface -------------------------------------------------
+    @property
+    def name(self) -> str:
+        return self._name
+
+    @property
+    def platform(self) -> str:
+        return self._platform.name
+
+    @property
+    def mobility(self) -> Platform:
+        return self._platform
+
+    @property
+    def position(self) -> np.ndarray:
+        return self._pos.copy()
+
+    @property
+    def yaw_rad(self) -> float:
+        return self._yaw
+
+    @property
+    def home(self) -> np.ndarray:
+        return self._home.copy()
+
+    @property
+    def onboard_map(self) -> VoxelMap:
+        return self._map
+
+    @property
+    def endurance_remaining_s(self) -> float:
+        return self._endurance
+
+    @property
+    def distance_m(self) -> float:
+        return self._distance
+
+    @property
+    def traversed_path(self) -> np.ndarray:
+        return np.array(self._trail)
+
+    @property
+    def radio(self) -> "RadioEndpoint":
+        return self._radio
+
+    @property
+    def path_status(self) -> str:
+        return self._status
+
+    @property
+    def alive(self) -> bool:
+        return self._endurance > 0
+
+    def follow_path(self, path: np.ndarray) -> None:
+        path = np.asarray(path, dtype=float).reshape(-1, 3)
+        if len(path) == 0 or not np.all(np.isfinite(path)):
+            self._status, self.blocked_reason = BLOCKED, "empty or non-finite path"
+            return
+        self._path, self._wp, self._status, self.blocked_reason = path, 0, FOLLOWING, ""
+
+    def stop(self) -> None:
+        self._path = None
+        if self._status == FOLLOWING:
+            self._status = IDLE
+
+    # ---- simulation ------------------------------------------------------------
+    def step(self, dt_s: float) -> None:
+        """Advance endurance and motion by one sim step."""
+        if not self.alive:
+            return
+        self._endurance = max(0.0, self._endurance - dt_s)
+        if self._endurance == 0.0:
+            self._path = None
+            self._status = BLOCKED
+            self.blocked_reason = "endurance exhausted"
+            return
+        if self._status != FOLLOWING or self._path is None:
+            return
+        budget = self._platform.speed_mps * dt_s
+        while budget > 1e-9 and self._status == FOLLOWING:
+            target = self._path[self._wp]
+            delta = target - self._pos
+            if not self._platform.aerial:
+                delta[2] = 0.0
+            dist = float(np.linalg.norm(delta))
+            if dist < 1e-6:
+                self._wp += 1
+                if self._wp >= len(self._path):
+                    self._status, self._path = ARRIVED, None
+                continue
+            move = min(budget, dist)
+            if not self._move(self._pos + delta * (move / dist)):
+                return
+            budget -= move
+            self._yaw = math.atan2(delta[1], delta[0])
+
+    def _move(self, new: np.ndarray) -> bool:
+        """Move to ``new`` if the platform can stand or fly there; else stop BLOCKED."""
+        p = self._platform
+        if p.aerial:
+            if not self.world.is_free(new[None])[0]:
+                return self._block("rock in the way")
+        else:
+            probe = np.array([[new[0], new[1], self._ground + p.max_step_m + self.world.voxel_size_m]])
+            ground = float(self.world.ground_height(probe, 2 * p.max_step_m + 2 * self.world.voxel_size_m)[0])
+            if math.isnan(ground) or abs(ground - self._ground) > p.max_step_m + 1e-6:
+                return self._block("no ground or step too high")
+            new = np.array([new[0], new[1], ground + p.body_height_m])
+            if not self.world.is_free(new[None])[0]:
+                return self._block("rock in the way")
+            travelled = self._slope_hist[-1][0] + float(np.hypot(*(new[:2] - self._pos[:2])))
+            hist = self._slope_hist + [(travelled, ground)]
+            while len(hist) > 2 and travelled - hist[1][0] >= self.inclination_window_m:
+                hist.pop(0)
+            run = travelled - hist[0][0]
+            if run >= self.inclination_window_m:
+                incline = math.degrees(math.atan2(abs(ground - hist[0][1]), run))
+                if incline > p.max_inclination_deg:
+                    return self._block(f"inclination {incline:.0f}° above {p.max_inclination_deg:.0f}°")
+            self._slope_hist = hist
+            self._ground = ground
+        step = float(np.linalg.norm(new - self._pos))
+        self._distance += step
+        self._trail_since += step
+        self._pos = new
+        if self._trail_since >= self.trail_spacing_m:
+            self._trail.append(new.copy())
+            self._trail_since = 0.0
+        return True
+
+    def _block(self, reason: str) -> bool:
+        self._status, self.blocked_reason, self._path = BLOCKED, reason, None
+        return False
+
+    def scan(self) -> None:
+        """Cast one LiDAR sweep and integrate it into the onboard map."""
+        spec = self._platform.lidar
+        sensor = self._pos + np.array([0.0, 0.0, spec.mount_height_m])
+        # Rotate the fan a little each sweep, as an unsynchronised spinning LiDAR does,
+        # so that successive sweeps sample different voxels.
+        offset = (self._scans * _GOLDEN) % 1.0 * math.radians(spec.horizontal_resolution_deg)
+        yaw = self._yaw if spec.horizontal_fov_deg < 360 else 0.0
+        c, s = math.cos(yaw + offset), math.sin(yaw + offset)
+        b = self._beams
+        dirs = np.stack([c * b[:, 0] - s * b[:, 1], s * b[:, 0] + c * b[:, 1], b[:, 2]], axis=1)
+        ranges = self.world.cast_rays(np.broadcast_to(sensor, dirs.shape), dirs, spec.range_m)
+        self._map.integrate_scan(sensor, dirs, ranges, spec.range_m)
+        self._scans += 1
