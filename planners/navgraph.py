@@ -18,6 +18,7 @@ from scipy.spatial import cKDTree
 
 from .occupancy import FREE, OCCUPIED, UNKNOWN, Grid
 
+FACES = ((1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0), (0, 0, 1), (0, 0, -1))
 _NEIGHBOURS_8 = [(di, dj) for di in (-1, 0, 1) for dj in (-1, 0, 1) if (di, dj) != (0, 0)]
 
 
@@ -77,25 +78,51 @@ class _Lookup:
         self.buf[self.flat] = -1
 
 
-def _offset_ok(ijk: np.ndarray, d: tuple[int, int, int], shape: tuple[int, int, int]) -> np.ndarray:
-    t = ijk + np.array(d)
-    return np.all((t >= 0) & (t < np.array(shape)), axis=1)
+class Voxels:
+    """A sparse set of voxels of a grid (flat indices) with fast neighbour look-ups.
 
+    Each voxel's distance to the grid's boundary is computed once, so a look-up at an
+    offset checks bounds only for the few voxels nearer the boundary than the offset.
+    """
 
-def neighbour_values(
-    flat_occ: np.ndarray,
-    flat: np.ndarray,
-    ijk: np.ndarray,
-    d: tuple[int, int, int],
-    shape: tuple[int, int, int],
-    outside: int,
-) -> np.ndarray:
-    """Occupancy of the voxel at offset ``d`` from each voxel; ``outside`` beyond the grid."""
-    ok = _offset_ok(ijk, d, shape)
-    out = np.full(len(flat), outside, dtype=np.int8)
-    step = (d[0] * shape[1] + d[1]) * shape[2] + d[2]
-    out[ok] = flat_occ[flat[ok] + step]
-    return out
+    def __init__(self, flat: np.ndarray, shape: tuple[int, int, int], ijk: np.ndarray | None = None,
+                 margin: np.ndarray | None = None):
+        self.flat, self.shape = flat, shape
+        self.ijk = np.stack(np.unravel_index(flat, shape), axis=1) if ijk is None else ijk
+        if margin is None:
+            i, j, k = self.ijk.T
+            nx, ny, nz = shape
+            margin = np.minimum.reduce([i, j, k, nx - 1 - i, ny - 1 - j, nz - 1 - k]) if len(flat) else i
+        self.margin = margin
+        self._near: dict[int, np.ndarray] = {}
+
+    def __len__(self) -> int:
+        return len(self.flat)
+
+    def subset(self, mask: np.ndarray) -> "Voxels":
+        """The voxels selected by a boolean mask or index array."""
+        return Voxels(self.flat[mask], self.shape, self.ijk[mask], self.margin[mask])
+
+    def _near_boundary(self, r: int) -> np.ndarray:
+        if r not in self._near:
+            self._near[r] = np.flatnonzero(self.margin < r)
+        return self._near[r]
+
+    def at(self, values: np.ndarray, d: tuple[int, int, int], outside: int) -> np.ndarray:
+        """``values`` (a flat array over the grid) at offset ``d`` from each voxel;
+        ``outside`` where that falls beyond the grid."""
+        step = (d[0] * self.shape[1] + d[1]) * self.shape[2] + d[2]
+        near = self._near_boundary(max(abs(d[0]), abs(d[1]), abs(d[2])))
+        if len(near) == 0:
+            return values[self.flat + step]
+        target = self.flat + step
+        target[near] = 0
+        out = values[target]
+        t = self.ijk[near] + np.array(d)
+        ok = np.all((t >= 0) & (t < np.array(self.shape)), axis=1)
+        out[near] = outside
+        out[near[ok]] = values[self.flat[near[ok]] + step]
+        return out
 
 
 def legged_graph(
@@ -107,28 +134,37 @@ def legged_graph(
     max_inclination_deg: float,
     headroom_m: float | None = None,
     inclination_baseline_m: float = 0.6,
+    ground_inference_radius_m: float = 1.0,
 ) -> NavGraph:
     """Graph of standable voxels, 8-connected horizontally with steps up to ``max_step_m``.
 
-    A voxel is standable when it is known FREE, has rock directly below, no rock in
-    the ``headroom_m`` above it (default: body height + 0.2 m) and none within
-    ``radius_m`` horizontally at body height. The ground inclination is estimated by
-    central differences of standable heights ``inclination_baseline_m`` apart.
+    A voxel is standable when it is known FREE, stands on ground, has no rock in the
+    ``headroom_m`` above it (default: body height + 0.2 m) and none within
+    ``radius_m`` horizontally at body height. Ground is rock seen directly below, or,
+    where the voxel below was never hit (a spinning LiDAR sees the floor only on rings
+    of its lower beams), ground seen at the same height within
+    ``ground_inference_radius_m``. The ground inclination is estimated by central
+    differences of standable heights ``inclination_baseline_m`` apart.
     """
-    occ, shape, vox = grid.occupancy, grid.shape, grid.voxel_size_m
-    flat_occ = occ.reshape(-1)
-    free = np.flatnonzero(flat_occ == FREE)
-    ijk = np.stack(np.unravel_index(free, shape), axis=1)
-    below = neighbour_values(flat_occ, free, ijk, (0, 0, -1), shape, UNKNOWN)
-    cand, cijk = free[below == OCCUPIED], ijk[below == OCCUPIED]
+    shape, vox = grid.shape, grid.voxel_size_m
+    flat_occ = grid.occupancy.reshape(-1)
+    free = Voxels(np.flatnonzero(flat_occ == FREE), shape)
+    below = free.at(flat_occ, (0, 0, -1), UNKNOWN)
+    on_rock = below == OCCUPIED
+    stand = on_rock
+    if ground_inference_radius_m > 0 and on_rock.any():
+        unknown = np.flatnonzero(below == UNKNOWN)
+        near = _same_height_near(free.ijk[on_rock], free.ijk[unknown], ground_inference_radius_m / vox)
+        stand = on_rock.copy()
+        stand[unknown[near]] = True
+    cand = free.subset(stand)
     headroom = body_height_m + 0.2 if headroom_m is None else headroom_m
     n_up = max(1, math.ceil(headroom / vox) - 1)
     ok = np.ones(len(cand), dtype=bool)
     for c in range(1, n_up + 1):
-        ok &= neighbour_values(flat_occ, cand, cijk, (0, 0, c), shape, OCCUPIED) != OCCUPIED
-    cand, cijk = cand[ok], cijk[ok]
-    incline = _inclination_deg(cand, cijk, shape, vox, max_inclination_deg, inclination_baseline_m)
-    keep = incline <= max_inclination_deg
+        ok &= cand.at(flat_occ, (0, 0, c), OCCUPIED) != OCCUPIED
+    cand = cand.subset(ok)
+    keep = _inclination_deg(cand, vox, max_inclination_deg, inclination_baseline_m) <= max_inclination_deg
     r = max(1, int(round(radius_m / vox)))
     layers = sorted({1, max(1, n_up // 2), n_up})
     for di in range(-r, r + 1):
@@ -136,47 +172,36 @@ def legged_graph(
             if (di, dj) == (0, 0) or di * di + dj * dj > r * r:
                 continue
             for c in layers:
-                keep &= neighbour_values(flat_occ, cand, cijk, (di, dj, c), shape, OCCUPIED) != OCCUPIED
-    nodes, nijk = cand[keep], cijk[keep]
-    positions = grid.to_world(nijk)
+                keep &= cand.at(flat_occ, (di, dj, c), OCCUPIED) != OCCUPIED
+    nodes = cand.subset(keep)
+    positions = grid.to_world(nodes.ijk)
     positions[:, 2] += body_height_m - 0.5 * vox
     max_dz = max(1, int(math.floor(max_step_m / vox + 1e-9)))
-    rows, cols, w = [], [], []
-    with _Lookup(flat_occ.size, nodes) as ids:
-        for di, dj in _NEIGHBOURS_8:
-            if (di, dj) < (0, 0):
-                continue  # each undirected edge once
-            for dz in range(-max_dz, max_dz + 1):
-                ok = _offset_ok(nijk, (di, dj, dz), shape)
-                src = np.flatnonzero(ok)
-                tgt = ids[nodes[src] + (di * shape[1] + dj) * shape[2] + dz]
-                hit = tgt >= 0
-                rows.append(src[hit])
-                cols.append(tgt[hit])
-                w.append(np.full(hit.sum(), vox * math.sqrt(di * di + dj * dj + dz * dz)))
-    return _graph(positions, rows, cols, w)
+    offsets = [(di, dj, dz) for di, dj in _NEIGHBOURS_8 if (di, dj) > (0, 0) for dz in range(-max_dz, max_dz + 1)]
+    return _graph(nodes, positions, offsets, vox)
 
 
-def _inclination_deg(
-    cand: np.ndarray,
-    cijk: np.ndarray,
-    shape: tuple[int, int, int],
-    vox: float,
-    limit_deg: float,
-    baseline_m: float,
-) -> np.ndarray:
+def _same_height_near(ground: np.ndarray, query: np.ndarray, radius_cells: float) -> np.ndarray:
+    """Which ``query`` voxels have a ``ground`` voxel at the same height within
+    ``radius_cells`` horizontally (heights are scaled apart so they never match)."""
+    if len(query) == 0:
+        return np.zeros(0, dtype=bool)
+    scale = np.array([1.0, 1.0, 10.0 * (radius_cells + 1)])
+    d, _ = cKDTree(ground * scale).query(query * scale, distance_upper_bound=radius_cells + 1e-9)
+    return np.isfinite(d)
+
+
+def _inclination_deg(cand: Voxels, vox: float, limit_deg: float, baseline_m: float) -> np.ndarray:
     """Ground inclination at each standable voxel from neighbours ``baseline_m`` away."""
     b = max(1, int(round(baseline_m / vox)))
     search = max(2, math.ceil(b * math.tan(math.radians(min(limit_deg + 15, 80)))))
     heights = {}
-    with _Lookup(int(np.prod(shape)), cand) as ids:
+    with _Lookup(int(np.prod(cand.shape)), cand.flat) as ids:
         for di, dj in ((b, 0), (-b, 0), (0, b), (0, -b)):
             h = np.full(len(cand), np.nan)
             for dz in sorted(range(-search, search + 1), key=abs):
-                ok = _offset_ok(cijk, (di, dj, dz), shape) & np.isnan(h)
-                src = np.flatnonzero(ok)
-                hit = ids[cand[src] + (di * shape[1] + dj) * shape[2] + dz] >= 0
-                h[src[hit]] = dz
+                hit = (cand.at(ids, (di, dj, dz), -1) >= 0) & np.isnan(h)
+                h[hit] = dz
             heights[(di, dj)] = h
     grads = []
     for plus, minus in (((b, 0), (-b, 0)), ((0, b), (0, -b))):
@@ -196,33 +221,27 @@ def aerial_graph(grid: Grid, *, block: int = 2) -> NavGraph:
     cropped = occ[: nb[0] * block, : nb[1] * block, : nb[2] * block]
     blocks = cropped.reshape(nb[0], block, nb[1], block, nb[2], block)
     all_free = (blocks == FREE).all(axis=(1, 3, 5))
-    any_rock = (blocks == OCCUPIED).any(axis=(1, 3, 5))
-    flat_free = np.flatnonzero(all_free)
-    ijk = np.stack(np.unravel_index(flat_free, nb), axis=1)
-    rock = any_rock.reshape(-1).astype(np.int8)
-    keep = np.ones(len(flat_free), dtype=bool)
-    for d in ((1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0), (0, 0, 1), (0, 0, -1)):
-        keep &= neighbour_values(rock, flat_free, ijk, d, nb, 1) == 0
-    nodes, nijk = flat_free[keep], ijk[keep]
-    positions = grid.origin + (nijk + 0.5) * block * grid.voxel_size_m
-    rows, cols, w = [], [], []
+    rock = (blocks == OCCUPIED).any(axis=(1, 3, 5)).reshape(-1)
+    free = Voxels(np.flatnonzero(all_free), nb)
+    keep = np.ones(len(free), dtype=bool)
+    for d in FACES:
+        keep &= ~free.at(rock, d, True)
+    nodes = free.subset(keep)
+    positions = grid.origin + (nodes.ijk + 0.5) * block * grid.voxel_size_m
     offsets = [(a, b, c) for a in (-1, 0, 1) for b in (-1, 0, 1) for c in (-1, 0, 1) if (a, b, c) > (0, 0, 0)]
-    with _Lookup(int(np.prod(nb)), nodes) as ids:
+    return _graph(nodes, positions, offsets, block * grid.voxel_size_m)
+
+
+def _graph(nodes: Voxels, positions: np.ndarray, offsets: list[tuple[int, int, int]], cell_m: float) -> NavGraph:
+    """Connect nodes to the nodes at ``offsets`` (each undirected edge once)."""
+    rows, cols, w = [], [], []
+    with _Lookup(int(np.prod(nodes.shape)), nodes.flat) as ids:
         for d in offsets:
-            ok = _offset_ok(nijk, d, nb)
-            src = np.flatnonzero(ok)
-            tgt = ids[nodes[src] + (d[0] * nb[1] + d[1]) * nb[2] + d[2]]
-            hit = tgt >= 0
-            rows.append(src[hit])
-            cols.append(tgt[hit])
-            w.append(np.full(hit.sum(), block * grid.voxel_size_m * math.sqrt(sum(x * x for x in d))))
-    return _graph(positions, rows, cols, w)
-
-
-def _graph(positions: np.ndarray, rows: list, cols: list, w: list) -> NavGraph:
+            tgt = nodes.at(ids, d, -1)
+            src = np.flatnonzero(tgt >= 0)
+            rows.append(src)
+            cols.append(tgt[src])
+            w.append(np.full(len(src), cell_m * math.sqrt(d[0] ** 2 + d[1] ** 2 + d[2] ** 2)))
     n = len(positions)
-    r = np.concatenate(rows) if rows else np.zeros(0, int)
-    c = np.concatenate(cols) if cols else np.zeros(0, int)
-    v = np.concatenate(w) if w else np.zeros(0)
-    adj = csr_matrix((v, (r, c)), shape=(n, n))
+    adj = csr_matrix((np.concatenate(w), (np.concatenate(rows), np.concatenate(cols))), shape=(n, n))
     return NavGraph(positions=positions, adjacency=adj)

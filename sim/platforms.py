@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from .lidar import LidarSpec
+from .lidar import TERRAIN_CAMERAS, LidarSpec
 
 
 @dataclass(frozen=True)
@@ -20,6 +20,7 @@ class Platform:
     max_inclination_deg: float = 90.0
     max_step_m: float = 0.0
     lidar: LidarSpec = field(default_factory=LidarSpec)
+    terrain: LidarSpec | None = None
 
 
 #: A quadruped like ANYmal C: about 1 m/s, steps up to 0.3 m, slopes up to 35°.
@@ -33,7 +34,9 @@ LEGGED = Platform(
     max_inclination_deg=35.0,
     max_step_m=0.3,
     lidar=LidarSpec(vertical_fov_deg=30.0),
+    terrain=TERRAIN_CAMERAS,
 )
+
 #: A small flying robot like RMF-Obelix: about 2 m/s, 360×90° LiDAR, short endurance.
 AERIAL = Platform(
     name="aerial",

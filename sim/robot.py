@@ -66,7 +66,7 @@ class SimRobot:
         self._status = IDLE
         self.blocked_reason = ""
         self._scans = 0
-        self._beams = platform.lidar.beam_directions(0.0)
+        self._sensors = [(spec, spec.beam_directions(0.0)) for spec in (platform.lidar, platform.terrain) if spec]
 
     # ---- the robot interface -------------------------------------------------
     @property
@@ -171,8 +171,7 @@ class SimRobot:
             if not self.world.is_free(new[None])[0]:
                 return self._block("rock in the way")
         else:
-            probe = np.array([[new[0], new[1], self._ground + p.max_step_m + self.world.voxel_size_m]])
-            ground = float(self.world.ground_height(probe, 2 * p.max_step_m + 2 * self.world.voxel_size_m)[0])
+            ground = self._ground_below(new[0], new[1])
             if math.isnan(ground) or abs(ground - self._ground) > p.max_step_m + 1e-6:
                 return self._block("no ground or step too high")
             new = np.array([new[0], new[1], ground + p.body_height_m])
@@ -198,21 +197,31 @@ class SimRobot:
             self._trail_since = 0.0
         return True
 
+    def _ground_below(self, x: float, y: float) -> float:
+        """Height of the rock surface under (x, y) near the current ground, by a ray cast
+        down onto the world mesh (continuous, unlike the voxel grid); NaN if none."""
+        reach = self._platform.max_step_m + 0.3
+        probe = np.array([[x, y, self._ground + reach]])
+        if not self.world.is_free(probe)[0]:
+            return math.nan
+        d = float(self.world.cast_rays(probe, np.array([[0.0, 0.0, -1.0]]), 2 * reach)[0])
+        return self._ground + reach - d if math.isfinite(d) else math.nan
+
     def _block(self, reason: str) -> bool:
         self._status, self.blocked_reason, self._path = BLOCKED, reason, None
         return False
 
     def scan(self) -> None:
-        """Cast one LiDAR sweep and integrate it into the onboard map."""
-        spec = self._platform.lidar
-        sensor = self._pos + np.array([0.0, 0.0, spec.mount_height_m])
-        # Rotate the fan a little each sweep, as an unsynchronised spinning LiDAR does,
-        # so that successive sweeps sample different voxels.
-        offset = (self._scans * _GOLDEN) % 1.0 * math.radians(spec.horizontal_resolution_deg)
-        yaw = self._yaw if spec.horizontal_fov_deg < 360 else 0.0
-        c, s = math.cos(yaw + offset), math.sin(yaw + offset)
-        b = self._beams
-        dirs = np.stack([c * b[:, 0] - s * b[:, 1], s * b[:, 0] + c * b[:, 1], b[:, 2]], axis=1)
-        ranges = self.world.cast_rays(np.broadcast_to(sensor, dirs.shape), dirs, spec.range_m)
-        self._map.integrate_scan(sensor, dirs, ranges, spec.range_m)
+        """One sweep of each range sensor (LiDAR, terrain cameras) into the onboard map."""
+        # Rotate each fan a little every sweep, as an unsynchronised spinning LiDAR
+        # does, so that successive sweeps sample different voxels.
+        turn = (self._scans * _GOLDEN) % 1.0
+        for spec, beams in self._sensors:
+            sensor = self._pos + np.array([0.0, 0.0, spec.mount_height_m])
+            yaw = (self._yaw if spec.horizontal_fov_deg < 360 else 0.0) + turn * math.radians(
+                spec.horizontal_resolution_deg)
+            c, s = math.cos(yaw), math.sin(yaw)
+            dirs = np.stack([c * beams[:, 0] - s * beams[:, 1], s * beams[:, 0] + c * beams[:, 1], beams[:, 2]], axis=1)
+            ranges = self.world.cast_rays(np.broadcast_to(sensor, dirs.shape), dirs, spec.range_m)
+            self._map.integrate_scan(sensor, dirs, ranges, spec.range_m)
         self._scans += 1

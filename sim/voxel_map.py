@@ -31,13 +31,6 @@ class VoxelMap:
     def shape(self) -> tuple[int, int, int]:
         return self.occupancy.shape  # type: ignore[return-value]
 
-    def flat_index(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Flat voxel indices of (N, 3) points and a mask of those inside the grid."""
-        idx = np.floor((points - self.origin) / self.voxel_size_m).astype(np.int64)
-        inside = np.all((idx >= 0) & (idx < np.array(self.shape)), axis=1)
-        idx = idx[inside]
-        return np.ravel_multi_index(idx.T, self.shape), inside
-
     def integrate_scan(
         self, sensor: np.ndarray, directions: np.ndarray, ranges: np.ndarray, max_range_m: float
     ) -> None:
@@ -46,27 +39,38 @@ class VoxelMap:
         ``ranges`` is np.inf for rays without a return within ``max_range_m``.
         """
         hit = np.isfinite(ranges)
-        step = 0.7 * self.voxel_size_m
-        free_len = np.where(hit, ranges - 0.5 * self.voxel_size_m, max_range_m)
+        vox = self.voxel_size_m
+        occ = self.occupancy.reshape(-1)
+        # Free space: samples every 0.7 voxel along each ray, up to half a voxel before
+        # its hit, worked out per axis in voxel units (float32) to keep it light.
+        step = np.float32(0.7)
+        free_len = np.where(hit, ranges / vox - 0.5, max_range_m / vox).astype(np.float32)
         counts = np.maximum(np.floor(free_len / step).astype(np.int64), 0)
         total = int(counts.sum())
-        occ = self.occupancy.reshape(-1)
         if total:
-            ray = np.repeat(np.arange(len(counts)), counts)
+            ray = np.repeat(np.arange(len(counts), dtype=np.int32), counts)
             first = np.cumsum(counts) - counts
-            t = (np.arange(total) - first[ray] + 0.5) * step
-            pts = sensor + directions[ray] * t[:, None]
-            flat, _ = self.flat_index(pts)
-            flat = flat[occ[flat] == UNKNOWN]
-            occ[flat] = FREE
-            self._dirty.reshape(-1)[flat] = True
+            t = (np.arange(total, dtype=np.float32) - first[ray].astype(np.float32) + np.float32(0.5)) * step
+            start = ((sensor - self.origin) / vox).astype(np.float32)
+            d32 = directions.astype(np.float32)
+            axes = [np.floor(start[a] + d32[ray, a] * t).astype(np.int64) for a in range(3)]
+            self._mark(axes, occ, UNKNOWN, FREE)
         if hit.any():
-            ends = sensor + directions[hit] * (ranges[hit] + 0.25 * self.voxel_size_m)[:, None]
-            flat, _ = self.flat_index(ends)
-            flat = flat[occ[flat] != OCCUPIED]
-            occ[flat] = OCCUPIED
-            self._dirty.reshape(-1)[flat] = True
+            ends = (sensor + directions[hit] * (ranges[hit] + 0.25 * vox)[:, None] - self.origin) / vox
+            axes = [np.floor(ends[:, a]).astype(np.int64) for a in range(3)]
+            self._mark(axes, occ, None, OCCUPIED)
         self.version += 1
+
+    def _mark(self, axes: list[np.ndarray], occ: np.ndarray, only: int | None, value: int) -> None:
+        """Set voxels (given by per-axis indices) to ``value``: all of them inside the
+        grid, or only those currently equal to ``only``."""
+        nx, ny, nz = self.shape
+        i, j, k = axes
+        inside = (i >= 0) & (i < nx) & (j >= 0) & (j < ny) & (k >= 0) & (k < nz)
+        flat = ((i * ny + j) * nz + k)[inside]
+        flat = flat[occ[flat] == only] if only is not None else flat[occ[flat] != value]
+        occ[flat] = value
+        self._dirty.reshape(-1)[flat] = True
 
     def take_changes(self) -> tuple[np.ndarray, np.ndarray]:
         """Flat indices and values of the voxels changed since the last call."""

@@ -54,6 +54,9 @@ class MapView(Protocol):
     def version(self) -> int:
         """Increases each time the map changes, so planners can cache."""
 
+    def take_changes(self) -> tuple[np.ndarray, np.ndarray]:
+        """Flat voxel indices and values changed since the last call (for map sharing)."""
+
 
 @dataclass(frozen=True)
 class Message:

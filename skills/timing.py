@@ -15,7 +15,7 @@ from py_trees.common import Status
 
 from .base import REQUIRED, AgentContext, Param, Skill
 
-__all__ = ["Timer", "Timeout"]
+__all__ = ["Timeout", "Timer"]
 
 
 def _check_duration(duration_s: Any) -> float:

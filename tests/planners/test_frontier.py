@@ -28,7 +28,7 @@ def test_frontier_voxels_border_unknown_space():
 
 def test_clusters_and_nearest_choice():
     grid = t_junction()
-    clusters = frontier_clusters(grid, frontier_voxels(grid), cluster_radius_m=0.35, min_cluster_voxels=5)
+    clusters = frontier_clusters(grid, frontier_voxels(grid), cluster_radius_m=0.8, min_cluster_voxels=5, max_extent_m=20.0)
     assert len(clusters) == 2
     g = legged_graph(grid, body_height_m=0.5, radius_m=0.4, max_step_m=0.3, max_inclination_deg=35)
     src = g.nearest(np.array([3.5, 5.5, 0.9]), 1.0)

@@ -1,0 +1,149 @@
+"""The ``delve`` command line.
+
+    delve run SCENARIO [--out DIR] [--seed N] [--duration-s S] [--quiet]
+    delve validate FILE...
+    delve render TREE --format svg|dot|png|txt [--out PATH]
+    delve demo
+
+Exit status: 0 when the mission succeeds (every robot's tree ends in SUCCESS), 1
+when it fails, 2 for bad input (one line naming file and line, no traceback).
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+from .. import SCENARIOS_DIR
+from .errors import DelveError
+from .yamlio import YamlDict, load_yaml
+
+DEMO_SCENARIO = SCENARIOS_DIR / "demo.yaml"
+
+
+def _parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="delve", description="Behaviour-tree mission executive for subterranean robot teams.")
+    sub = p.add_subparsers(dest="command", required=True)
+    run = sub.add_parser("run", help="run a scenario and write its outputs")
+    run.add_argument("scenario", type=Path)
+    run.add_argument("--out", type=Path, help="output directory (default: delve-out/<scenario name>)")
+    run.add_argument("--seed", type=int, help="override the scenario's seed")
+    run.add_argument("--duration-s", type=float, help="override the scenario's duration (sim seconds)")
+    run.add_argument("--quiet", action="store_true", help="no progress bar")
+    val = sub.add_parser("validate", help="check tree and scenario files")
+    val.add_argument("files", type=Path, nargs="+")
+    ren = sub.add_parser("render", help="draw a tree file")
+    ren.add_argument("tree", type=Path)
+    ren.add_argument("--format", choices=("svg", "dot", "png", "txt"), default="txt")
+    ren.add_argument("--out", type=Path, help="output file (default: TREE with the format's suffix)")
+    demo = sub.add_parser("demo", help="run the default scenario into ./delve-out/demo")
+    demo.add_argument("--quiet", action="store_true")
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = _parser().parse_args(argv)
+    try:
+        if args.command == "run":
+            return run(args.scenario, args.out, args.seed, args.duration_s, args.quiet)
+        if args.command == "demo":
+            return run(DEMO_SCENARIO, Path("delve-out/demo"), None, None, args.quiet)
+        if args.command == "validate":
+            return validate(args.files)
+        if args.command == "render":
+            return render(args.tree, args.format, args.out)
+    except DelveError as err:
+        print(err, file=sys.stderr)
+        return 2
+    return 2
+
+
+def run(path: Path, out: Path | None, seed: int | None, duration_s: float | None, quiet: bool) -> int:
+    """Run a scenario, write its outputs, print a summary; exit status per the mission."""
+    from .outputs import write_outputs
+    from .runner import Mission
+    from .scenario import load_scenario
+
+    if seed is not None and seed < 0:
+        raise DelveError(f"--seed must be >= 0, got {seed}")
+    if duration_s is not None and not duration_s > 0:
+        raise DelveError(f"--duration-s must be > 0, got {duration_s}")
+    scenario = load_scenario(path)
+    out = out or Path("delve-out") / scenario.name
+    started = time.perf_counter()
+    mission = Mission(scenario, seed=seed, duration_s=duration_s)
+    if quiet:
+        mission.run()
+    else:
+        _run_with_progress(mission)
+    rep = write_outputs(mission, out, time.perf_counter() - started)
+    print(f"{scenario.name}: {'succeeded' if rep['succeeded'] else 'FAILED'} after {rep['sim_time_s']:.0f} s sim "
+          f"({rep['wall_time_s']:.1f} s wall), coverage {rep['coverage_fraction']:.1%}, "
+          f"at base {rep['base_coverage_fraction']:.1%}")
+    for r in rep["robots"]:
+        print(f"  {r['name']} ({r['platform']}): {r['final_status']}, {r['distance_m']:.0f} m, "
+              f"home={'yes' if r['returned_home'] else 'no'}, {r['endurance_left_s']:.0f} s endurance left")
+    print(f"outputs in {out}/")
+    return 0 if rep["succeeded"] else 1
+
+
+def _run_with_progress(mission) -> None:
+    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+
+    columns = (TextColumn("[bold]{task.description}"), BarColumn(), TextColumn("{task.fields[status]}"),
+               TimeElapsedColumn())
+    with Progress(*columns, transient=False) as bar:
+        task = bar.add_task(mission.scenario.name, total=mission.duration_s, status="")
+
+        def update(m) -> None:
+            s = m.state.samples[-1] if m.state.samples else None
+            states = " ".join(f"{n}:{a.root.status.value}" for n, a in m.agents.items() if n != "base")
+            cov = f"coverage {s.team:.0%}" if s else ""
+            bar.update(task, completed=min(m.clock.now_s, m.duration_s),
+                       status=f"t={m.clock.now_s:6.0f}s {cov} {states}")
+
+        mission.run(progress=update)
+        bar.update(task, completed=mission.duration_s)
+
+
+def validate(files: list[Path]) -> int:
+    """Check each file; print ``ok`` or the error. Exit 2 if any file is wrong."""
+    from .scenario import load_scenario
+    from .tree_loader import check_tree
+
+    status = 0
+    for f in files:
+        try:
+            doc = load_yaml(f)
+            if isinstance(doc, YamlDict) and ("robots" in doc or "world" in doc):
+                scenario = load_scenario(f)
+                scenario.check_starts(scenario.build_world())
+            else:
+                check_tree(f)
+            print(f"ok: {f}")
+        except DelveError as err:
+            print(err, file=sys.stderr)
+            status = 2
+    return status
+
+
+def render(tree: Path, fmt: str, out: Path | None) -> int:
+    from ..skills.base import AgentContext
+    from .render import render_tree
+    from .tree_loader import load_tree
+
+    ctx = AgentContext(name="render", namespace="/render", clock=_Still(), log=lambda *a, **k: None)
+    root = load_tree(tree, ctx)
+    out = out or tree.with_suffix(f".{fmt}")
+    render_tree(root, fmt, out)
+    print(f"wrote {out}")
+    return 0
+
+
+class _Still:
+    now_s = 0.0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,202 @@
+"""The mission runner: builds world, robots and agents from a scenario and runs the
+simulation until every robot's tree has finished or the scenario's time is up."""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field, replace
+from typing import Any, Callable
+
+import numpy as np
+import py_trees
+from py_trees.common import Status
+
+from ..sim.clock import SimClock
+from ..sim.platforms import PLATFORMS
+from ..sim.radio import RadioNetwork, RadioSpec
+from ..sim.robot import SimRobot
+from ..sim.voxel_map import VoxelMap
+from ..sim.world import World
+from ..skills.base import AgentContext
+from .agent import Agent
+from .errors import DelveError
+from .scenario import RobotSpec, Scenario
+from .tree_loader import load_tree
+
+BASE = "base"
+#: Sim time the runner keeps the radio going after the trees finish, so that what
+#: robots queued on their way home reaches the base station.
+FLUSH_S = 30.0
+_START_OFFSETS_M = [(0, 0), (1.2, 0), (-1.2, 0), (0, 1.2), (0, -1.2), (2.4, 0), (-2.4, 0), (2.4, 1.2),
+                    (-2.4, 1.2), (2.4, -1.2), (-2.4, -1.2), (3.6, 0), (-3.6, 0)]
+
+
+@dataclass
+class Sample:
+    """Coverage and robot states at one moment."""
+
+    t: float
+    team: float
+    base: float
+    robots: dict[str, float]
+    positions: dict[str, list[float]]
+    linked: dict[str, bool]
+
+
+@dataclass
+class MissionState:
+    """Everything a run produced, for reports and plots."""
+
+    events: list[dict[str, Any]] = field(default_factory=list)
+    samples: list[Sample] = field(default_factory=list)
+
+
+class Mission:
+    """A scenario made runnable: world, robots, radio, base station and agents."""
+
+    def __init__(self, scenario: Scenario, *, seed: int | None = None, duration_s: float | None = None,
+                 world: World | None = None):
+        self.scenario = scenario
+        self.seed = scenario.seed if seed is None else seed
+        self.duration_s = scenario.duration_s if duration_s is None else duration_s
+        self.world = world if world is not None else scenario.build_world(seed=self.seed)
+        scenario.check_starts(self.world)
+        self.clock = SimClock(scenario.dt_s)
+        self.state = MissionState()
+        rng = np.random.default_rng(self.seed)
+        self.radio = RadioNetwork(RadioSpec(**scenario.radio), self.world, rng, lambda: self.clock.now_s)
+        self.robots: dict[str, SimRobot] = {}
+        self.agents: dict[str, Agent] = {}
+        self._next_scan: dict[str, float] = {}
+        for i, spec in enumerate(scenario.robots):
+            self.robots[spec.name] = self._robot(spec, i)
+            self._next_scan[spec.name] = 0.0
+        base_pos = np.asarray(scenario.base_position if scenario.base_position is not None
+                              else self.world.start + np.array([0.0, 0.0, 1.0]), dtype=float)
+        self.base_position = base_pos
+        self.base_map = VoxelMap(self.world.free.shape, self.world.origin, self.world.voxel_size_m)
+        base_radio = self.radio.add(BASE, lambda: base_pos)
+        for spec in scenario.robots:
+            robot = self.robots[spec.name]
+            ctx = self._context(spec.name, robot)
+            self.agents[spec.name] = Agent(spec.name, load_tree(spec.tree, ctx), 1.0 / spec.tick_hz, ctx,
+                                           on_change=self._status_changed)
+        if scenario.base_tree is not None:
+            ctx = self._context(BASE, None)
+            ctx.services.update(radio=base_radio, map=self.base_map)
+            self.agents[BASE] = Agent(BASE, load_tree(scenario.base_tree, ctx), 1.0 / scenario.base_tick_hz, ctx,
+                                      on_change=self._status_changed)
+        reach = self.world.reachable_free(self._first_start())
+        self.truth = np.flatnonzero(reach.reshape(-1))
+        self.finished_s: float | None = None
+
+    # ---- construction -----------------------------------------------------------
+    def _first_start(self) -> np.ndarray:
+        r = next(iter(self.robots.values()))
+        return r.home - np.array([0.0, 0.0, r.mobility.body_height_m])
+
+    def _robot(self, spec: RobotSpec, index: int) -> SimRobot:
+        base = PLATFORMS[spec.platform]
+        platform = replace(base, **spec.overrides, lidar=replace(base.lidar, **spec.lidar))
+        start = np.asarray(spec.start, float) if spec.start is not None else self._free_start(index)
+        holder: dict[str, SimRobot] = {}
+        radio = self.radio.add(spec.name, lambda: holder["r"].position)
+        robot = SimRobot(spec.name, platform, self.world, start, radio, spec.endurance_s)
+        holder["r"] = robot
+        return robot
+
+    def _free_start(self, index: int) -> np.ndarray:
+        """A start on the floor near the world's start, a little apart for each robot."""
+        free = [np.asarray(self.world.start) + np.array([dx, dy, 0.0]) for dx, dy in _START_OFFSETS_M]
+        free = [p for p in free if self.world.start_problem(p + np.array([0, 0, 0.3])) is None]
+        if index >= len(free):
+            raise DelveError(f"no free start pose near the world's start for robot #{index + 1}",
+                             self.scenario.path, self.scenario.robots[index].line)
+        return free[index]
+
+    def _context(self, name: str, robot: SimRobot | None) -> AgentContext:
+        return AgentContext(name=name, namespace=f"/{name}", clock=self.clock, log=self.log, robot=robot)
+
+    # ---- events -----------------------------------------------------------------
+    def log(self, event: str, **fields: Any) -> None:
+        self.state.events.append({"t": self.clock.now_s, "event": event, **fields})
+
+    def _status_changed(self, agent: Agent, node: py_trees.behaviour.Behaviour, old: Status, new: Status) -> None:
+        self.log("status", agent=agent.name, node=node.name, old=old.value, new=new.value)
+
+    # ---- running ----------------------------------------------------------------
+    @property
+    def robot_agents(self) -> list[Agent]:
+        return [a for n, a in self.agents.items() if n != BASE]
+
+    def run(self, progress: Callable[["Mission"], None] | None = None, progress_period_s: float = 10.0) -> None:
+        """Run until every robot's tree has finished or ``duration_s`` has passed,
+        then keep the radio going for up to ``FLUSH_S`` to deliver what is queued."""
+        next_sample = next_progress = 0.0
+        self.log("mission_start", scenario=self.scenario.name, seed=self.seed)
+        while True:
+            now = self.clock.now_s
+            self._sense(now)
+            self.radio.update()
+            for agent in self.agents.values():
+                agent.tick_if_due(now)
+            if now + 1e-9 >= next_sample:
+                self._sample(now)
+                next_sample = now + self.scenario.coverage_period_s
+            if progress is not None and now + 1e-9 >= next_progress:
+                progress(self)
+                next_progress = now + progress_period_s
+            if all(a.finished for a in self.robot_agents) or now >= self.duration_s:
+                break
+            for robot in self.robots.values():
+                robot.step(self.clock.dt_s)
+            self.clock.step()
+        self.finished_s = self.clock.now_s
+        timed_out = not all(a.finished for a in self.robot_agents)
+        self.log("mission_end", timed_out=timed_out)
+        for agent in self.robot_agents:
+            if not agent.finished:
+                agent.stop()
+        self._flush()
+        self._sample(self.clock.now_s)
+        if progress is not None:
+            progress(self)
+
+    def _sense(self, now: float) -> None:
+        for name, robot in self.robots.items():
+            if robot.alive and now + 1e-9 >= self._next_scan[name]:
+                robot.scan()
+                self._next_scan[name] = now + 1.0 / robot.mobility.lidar.rate_hz
+
+    def _flush(self) -> None:
+        end = self.clock.now_s + FLUSH_S
+        base = self.agents.get(BASE)
+        while self.clock.now_s < end and any(ep.pending for ep in self.radio.endpoints.values()):
+            self.clock.step()
+            self.radio.update()
+            if base is not None:
+                base.tick_if_due(self.clock.now_s)
+        if base is not None:
+            base.tick_if_due(math.inf)
+
+    def _sample(self, now: float) -> None:
+        team = np.zeros(len(self.truth), dtype=bool)
+        per_robot = {}
+        for name, robot in self.robots.items():
+            seen = robot.onboard_map.occupancy.reshape(-1)[self.truth] == 0
+            per_robot[name] = round(float(seen.mean()) if len(seen) else 0.0, 5)
+            team |= seen
+        self.state.samples.append(Sample(
+            t=now,
+            team=round(float(team.mean()) if len(team) else 0.0, 5),
+            base=round(self.base_map.known_fraction_of(self.truth), 5),
+            robots=per_robot,
+            positions={n: [round(float(v), 3) for v in r.position] for n, r in self.robots.items()},
+            linked={n: self.radio.linked(n, BASE) for n in self.robots},
+        ))
+
+    # ---- results ----------------------------------------------------------------
+    @property
+    def succeeded(self) -> bool:
+        """Every robot's tree ended in SUCCESS."""
+        return all(a.root.status == Status.SUCCESS for a in self.robot_agents)

@@ -1,0 +1,188 @@
+"""Scenario files: reading, checking (JSON Schema, then meaning) and building the world.
+
+Every mistake becomes a one-line :class:`DelveError` with the file and line.
+"""
+from __future__ import annotations
+
+import inspect
+import json
+import math
+from dataclasses import dataclass, field
+from functools import lru_cache
+from pathlib import Path
+from typing import Any
+
+import jsonschema
+
+from ..sim import worldgen
+from ..sim.world import World
+from .errors import DelveError, did_you_mean
+from .yamlio import YamlDict, YamlList, load_yaml, plain
+
+SCHEMA_PATH = Path(__file__).parent / "schema" / "scenario.schema.json"
+GENERATORS = ("tunnel_network", "cave")
+MESH_OPTIONS = ("mesh", "scale", "up_axis", "voxel_size_m", "start", "seed")
+DEFAULTS = {"seed": 0, "duration_s": 3600.0, "dt_s": 0.1, "coverage_period_s": 5.0}
+
+
+@lru_cache(maxsize=1)
+def scenario_schema() -> dict:
+    return json.loads(SCHEMA_PATH.read_text())
+
+
+@dataclass
+class RobotSpec:
+    """One robot of a scenario, with its tree file resolved."""
+
+    name: str
+    platform: str
+    tree: Path
+    start: list[float] | None = None
+    endurance_s: float | None = None
+    tick_hz: float = 5.0
+    overrides: dict[str, float] = field(default_factory=dict)
+    lidar: dict[str, float] = field(default_factory=dict)
+    line: int | None = None
+
+
+@dataclass
+class Scenario:
+    """A checked scenario: plain values, resolved paths and where each came from."""
+
+    path: Path
+    name: str
+    seed: int
+    duration_s: float
+    dt_s: float
+    coverage_period_s: float
+    world: dict[str, Any]
+    robots: list[RobotSpec]
+    base_tree: Path | None
+    base_position: list[float] | None
+    base_tick_hz: float
+    radio: dict[str, float]
+    doc: YamlDict
+
+    def build_world(self, seed: int | None = None) -> World:
+        """Generate or load the world (a DelveError when its parameters are wrong).
+
+        A generator without its own ``seed`` takes ``seed``, else the scenario's."""
+        spec = dict(self.world)
+        line = self.doc["world"].line
+        try:
+            if "mesh" in spec:
+                mesh = (self.path.parent / spec.pop("mesh")).resolve()
+                if not mesh.exists():
+                    raise DelveError(f"mesh file not found: {mesh}", self.path, self.doc["world"].key_line("mesh"))
+                spec.pop("seed", None)
+                return worldgen.from_mesh(mesh, **spec)
+            gen = getattr(worldgen, spec.pop("generator"))
+            spec.setdefault("seed", self.seed if seed is None else seed)
+            return gen(**spec)
+        except ValueError as err:
+            raise DelveError(f"world: {err}", self.path, line) from None
+
+    def check_starts(self, world: World) -> None:
+        """Each robot's start pose must be inside the world and in free space."""
+        for r in self.robots:
+            if r.start is None:
+                continue
+            problem = world.start_problem(r.start)
+            if problem:
+                raise DelveError(f"robot {r.name!r}: start pose {r.start} is {problem}", self.path, r.line)
+        if self.base_position is not None:
+            problem = world.start_problem(self.base_position)
+            if problem:
+                raise DelveError(f"base station position is {problem}", self.path, self.doc["base_station"].line)
+
+
+def _schema_error(err: jsonschema.ValidationError, doc: Any, path: Path) -> DelveError:
+    """Turn a JSON Schema error into one line at the offending key."""
+    node, line = doc, getattr(doc, "line", None)
+    for part in err.absolute_path:
+        if isinstance(node, YamlDict):
+            line = node.key_line(part) or line
+        elif isinstance(node, YamlList):
+            line = node.item_line(part) or line
+        node = node[part]
+    where = "/".join(str(p) for p in err.absolute_path) or "scenario"
+    if err.validator == "additionalProperties":
+        allowed = err.schema.get("properties", {})
+        extra = sorted(set(node) - set(allowed))
+        key = extra[0] if extra else "?"
+        if isinstance(node, YamlDict):
+            line = node.key_line(key) or line
+        return DelveError(f"{where}: unknown key {key!r}{did_you_mean(key, allowed)}", path, line)
+    if err.validator == "required":
+        return DelveError(f"{where}: {err.message.replace(' is a required property', '')} is missing", path, line)
+    if err.validator == "oneOf" and where == "world":
+        return DelveError("world: give either 'generator' or 'mesh'", path, line)
+    if err.validator == "enum":
+        choices = ", ".join(map(repr, err.validator_value))
+        return DelveError(f"{where}: {err.instance!r} is not one of {choices}", path, line)
+    return DelveError(f"{where}: {err.message}", path, line)
+
+
+def _nan(doc: Any, path: Path) -> None:
+    """Reject NaN and infinite numbers anywhere in the file."""
+    items = doc.items() if isinstance(doc, dict) else enumerate(doc) if isinstance(doc, list) else ()
+    for k, v in items:
+        if isinstance(v, float) and not math.isfinite(v):
+            line = doc.key_line(k) if isinstance(doc, YamlDict) else doc.item_line(k)
+            raise DelveError(f"{k}: must be a finite number, not {v}", path, line)
+        _nan(v, path)
+
+
+def _world_params(world: YamlDict, path: Path) -> None:
+    if "mesh" in world:
+        allowed = MESH_OPTIONS
+    else:
+        allowed = ("generator",) + tuple(inspect.signature(getattr(worldgen, world["generator"])).parameters)
+    for key in world:
+        if key not in allowed:
+            raise DelveError(f"world: unknown parameter {key!r}{did_you_mean(key, allowed)}", path,
+                             world.key_line(key))
+
+
+def load_scenario(path: str | Path) -> Scenario:
+    """Read and check a scenario file (not its world: see :meth:`Scenario.build_world`)."""
+    path = Path(path)
+    doc = load_yaml(path)
+    if not isinstance(doc, YamlDict):
+        raise DelveError("a scenario file must be a mapping", path, getattr(doc, "line", 1))
+    _nan(doc, path)
+    errors = sorted(jsonschema.Draft202012Validator(scenario_schema()).iter_errors(doc),
+                    key=lambda e: (len(e.absolute_path), list(map(str, e.absolute_path))))
+    if errors:
+        raise _schema_error(jsonschema.exceptions.best_match(errors), doc, path)
+    _world_params(doc["world"], path)
+    from .tree_loader import check_tree
+
+    robots, names = [], set()
+    for i, r in enumerate(doc["robots"]):
+        line = doc["robots"].item_line(i)
+        if r["name"] in names or r["name"] == "base":
+            why = "is used twice" if r["name"] in names else "is reserved for the base station"
+            raise DelveError(f"robot name {r['name']!r} {why}", path, line)
+        names.add(r["name"])
+        tree = (path.parent / r["tree"]).resolve()
+        if not tree.exists():
+            raise DelveError(f"robot {r['name']!r}: tree file not found: {r['tree']}", path, r.key_line("tree"))
+        check_tree(tree)
+        extra = {k: float(r[k]) for k in ("speed_mps", "max_inclination_deg", "max_step_m") if k in r}
+        robots.append(RobotSpec(name=r["name"], platform=r["platform"], tree=tree, start=r.get("start"),
+                                endurance_s=r.get("endurance_s"), tick_hz=float(r.get("tick_hz", 5.0)),
+                                overrides=extra, lidar=plain(r.get("lidar", {})), line=line))
+    base = doc.get("base_station", {})
+    base_tree = None
+    if "tree" in base:
+        base_tree = (path.parent / base["tree"]).resolve()
+        if not base_tree.exists():
+            raise DelveError(f"base station tree file not found: {base['tree']}", path, base.key_line("tree"))
+        check_tree(base_tree)
+    values = {k: doc.get(k, v) for k, v in DEFAULTS.items()}
+    return Scenario(path=path, name=doc["name"], seed=int(values["seed"]), duration_s=float(values["duration_s"]),
+                    dt_s=float(values["dt_s"]), coverage_period_s=float(values["coverage_period_s"]),
+                    world=plain(doc["world"]), robots=robots, base_tree=base_tree,
+                    base_position=base.get("position"), base_tick_hz=float(base.get("tick_hz", 1.0)),
+                    radio=plain(doc.get("radio", {})), doc=doc)

@@ -1,0 +1,312 @@
+"""YAML tree files -> py_trees behaviour trees.
+
+A tree file's top-level mapping is the root node. A node is either a typed node::
+
+    type: Sequence            # a name from the registry (delve.executive.registry)
+    name: Explore then home   # optional, default: the type
+    memory: true              # parameters as sibling keys (units in names: timeout_s)
+    children:                 # composites and many-child idioms
+      - type: Explore
+      - type: Timeout         # decorators take `child:` (or `children:` with one node)
+        duration_s: 600
+        child: {type: Home}
+
+or an include of another file, its root renamed and blackboard keys remapped::
+
+    include: subtrees/return_home.yaml    # relative to this file
+    remap: {goal: home_pose}              # key in the subtree -> key here
+    name: Go home                         # optional
+
+Includes nest, remaps compose, and include cycles are reported with their chain.
+Every mistake raises :class:`~delve.executive.errors.DelveError` with the file, line
+and node.
+"""
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping
+from typing import Any
+
+from py_trees.behaviour import Behaviour
+
+from ..skills.base import AgentContext
+from .errors import DelveError, did_you_mean
+from .registry import Build, NodeType, Registry, Site, coerce_param, default_registry
+from .yamlio import YamlDict, YamlList, line_of, load_yaml
+
+__all__ = ["build_tree", "check_context", "check_tree", "compose_remap", "load_tree"]
+
+_INCLUDE_KEYS = ("include", "remap", "name")
+
+
+def compose_remap(inner: Mapping[str, str] | None, outer: Mapping[str, str] | None) -> dict[str, str]:
+    """The remap of a subtree included with ``inner`` into a tree that is itself
+    remapped with ``outer``: a subtree key goes through ``inner``, then ``outer``."""
+    composed = dict(outer or {})
+    for key, value in (inner or {}).items():
+        composed[key] = (outer or {}).get(value, value)
+    return composed
+
+
+def _describe(value: Any) -> str:
+    if value is None:
+        return "null"
+    if isinstance(value, list):
+        return "a list"
+    if isinstance(value, Mapping):
+        return "a mapping"
+    if isinstance(value, str):
+        return f"the string {value!r}"
+    return f"{type(value).__name__} {value!r}"
+
+
+class _ZeroClock:
+    """The clock of :func:`check_tree`'s dummy agent: time stands still at 0."""
+
+    now_s = 0.0
+
+
+def check_context() -> AgentContext:
+    """A dummy agent context to build trees with for checking (no robot, no log)."""
+    return AgentContext(name="check", namespace="/__check__", clock=_ZeroClock(), log=lambda *args, **fields: None)
+
+
+class _TreeBuilder:
+    def __init__(self, ctx: AgentContext, registry: Registry, root_file: str | None):
+        self.ctx = ctx
+        self.registry = registry
+        self.root_dir = os.path.dirname(os.path.realpath(root_file)) if root_file else os.getcwd()
+
+    # ---------------------------------------------------------------- files
+
+    def chain_name(self, real: str) -> str:
+        rel = os.path.relpath(real, self.root_dir)
+        return real if rel.startswith(os.pardir) else rel
+
+    def file(self, path: str, remap: dict[str, str], chain: tuple[str, ...]) -> Behaviour:
+        data = load_yaml(path)
+        if data is None:
+            raise DelveError("empty tree file: its top-level mapping must be the root node", path, 1)
+        return self.node(data, path, 1, remap, chain)
+
+    # ---------------------------------------------------------------- nodes
+
+    def node(self, data: Any, file: str | None, line: int | None, remap: dict[str, str], chain: tuple[str, ...]) -> Behaviour:
+        if not isinstance(data, Mapping):
+            raise DelveError(
+                f"a tree node must be a mapping with 'type' (or 'include'), not {_describe(data)}",
+                file,
+                line_of(data, line),
+            )
+        line = line_of(data, line)
+        if "include" in data:
+            return self.include(data, file, line, remap, chain)
+        return self.typed(data, file, line, remap, chain)
+
+    def include(self, data: Mapping[str, Any], file: str | None, line: int | None, remap: dict[str, str], chain: tuple[str, ...]) -> Behaviour:
+        site = Site(file, data, None, line)
+        name = data.get("name")
+        if name is not None and (not isinstance(name, str) or not name):
+            site.fail(f"'name' must be a non-empty string, not {_describe(name)}", "name")
+        site.node_name = name
+        for key in data:
+            if key not in _INCLUDE_KEYS:
+                hint = did_you_mean(str(key), _INCLUDE_KEYS)
+                if key == "type":
+                    hint = " (a node is either an include or a typed node, not both)"
+                site.fail(f"unknown key {key!r} in an include{hint}", key)
+        target = data["include"]
+        if not isinstance(target, str) or not target:
+            site.fail(f"'include' must be a path (a string), not {_describe(target)}", "include")
+        inner = data.get("remap") or {}
+        if not isinstance(inner, Mapping):
+            site.fail(f"'remap' must be a mapping of subtree key -> key, not {_describe(inner)}", "remap")
+        for key, value in inner.items():
+            if not isinstance(key, str) or not key or not isinstance(value, str) or not value:
+                line_hint = inner.key_line(key) if isinstance(inner, YamlDict) else None
+                raise DelveError(
+                    f"remap entries must map a key name to a key name, not {key!r}: {value!r}",
+                    file,
+                    line_hint or site.line_of("remap"),
+                    name,
+                )
+        base = os.path.dirname(file) if file else ""
+        path = os.path.normpath(os.path.join(base, target))
+        real = os.path.realpath(path)
+        if real in chain:
+            names = [self.chain_name(p) for p in chain[chain.index(real):]] + [self.chain_name(real)]
+            site.fail(f"include cycle: {' -> '.join(names)}", "include")
+        if not os.path.isfile(path):
+            what = "is a directory" if os.path.isdir(path) else "not found"
+            site.fail(f"included file {what}: {target!r} (looked for {path})", "include")
+        root = self.file(path, compose_remap(inner, remap), (*chain, real))
+        if name is not None:
+            root.name = name
+        return root
+
+    def typed(self, data: Mapping[str, Any], file: str | None, line: int | None, remap: dict[str, str], chain: tuple[str, ...]) -> Behaviour:
+        site = Site(file, data, None, line)
+        explicit_name = data.get("name")
+        if isinstance(explicit_name, str) and explicit_name:
+            site.node_name = explicit_name
+        if "type" not in data:
+            close = [k for k in data if isinstance(k, str) and did_you_mean(k, ("type", "include"))]
+            hint = f" ({close[0]!r} is not 'type' or 'include')" if close else ""
+            site.fail(f"node has no 'type' (or 'include'){hint}")
+        type_name = data["type"]
+        if not isinstance(type_name, str):
+            site.fail(f"'type' must be a string, not {_describe(type_name)}", "type")
+        node_type = self.registry.get(type_name)
+        if node_type is None:
+            site.fail(f"unknown behaviour type {type_name!r}{self.registry.suggest(type_name)}", "type")
+        if explicit_name is not None and (not isinstance(explicit_name, str) or not explicit_name):
+            site.fail(f"'name' must be a non-empty string, not {_describe(explicit_name)}", "name")
+        name = explicit_name or type_name
+        site.node_name = name
+
+        params, given = self.params(node_type, data, site)
+        children = self.children(node_type, data, site, remap, chain)
+        subtrees = {}
+        for slot in node_type.subtrees:
+            if slot not in data:
+                site.fail(f"{node_type.kind} {type_name!r} needs a '{slot}' subtree")
+            subtrees[slot] = self.node(data[slot], file, site.line_of(slot), remap, chain)
+
+        build = Build(
+            name=name,
+            params=params,
+            children=children,
+            ctx=self.ctx,
+            remap=dict(remap),
+            subtrees=subtrees,
+            given=frozenset(given),
+            site=site,
+        )
+        try:
+            return node_type.build(build)
+        except DelveError:
+            raise
+        except ValueError as err:
+            site.fail(f"cannot build {type_name!r}: {err}")
+
+    def params(self, node_type: NodeType, data: Mapping[str, Any], site: Site) -> tuple[dict[str, Any], list[str]]:
+        structural = {"type", "name", *node_type.subtrees}
+        if node_type.arity != "none":
+            structural |= {"children", "child"}
+        else:
+            for key in ("children", "child"):
+                if key in data:
+                    site.fail(f"{node_type.kind} {node_type.name!r} takes no children", key)
+        given = [k for k in data if k not in structural]
+        for key in given:
+            if key not in node_type.params:
+                known = [*node_type.params, *sorted(structural - {"type"})]
+                site.fail(f"unknown parameter {key!r} for {node_type.name!r}{did_you_mean(str(key), known)}", key)
+        values: dict[str, Any] = {}
+        missing = []
+        for pname, spec in node_type.params.items():
+            if pname in data:
+                value = data[pname]
+                problem = spec.problem(value)
+                if problem is None and spec.key and value is not None and not value.strip():
+                    problem = "must be a blackboard key name, not an empty string"
+                if problem is not None:
+                    site.fail(f"parameter {pname!r} {problem}", pname)
+                values[pname] = coerce_param(spec, value)
+            elif spec.required:
+                missing.append(pname)
+            else:
+                values[pname] = coerce_param(spec, spec.default)
+        if missing:
+            names = ", ".join(repr(m) for m in missing)
+            plural = "s" if len(missing) > 1 else ""
+            site.fail(f"missing required parameter{plural} {names} for {node_type.name!r}")
+        return values, given
+
+    def children(self, node_type: NodeType, data: Mapping[str, Any], site: Site, remap: dict[str, str], chain: tuple[str, ...]) -> list[Behaviour]:
+        what = f"{node_type.kind} {node_type.name!r}"
+        if node_type.arity == "none":
+            return []
+        has_child, has_children = "child" in data, "children" in data
+        if has_child and has_children:
+            site.fail(f"{what} takes 'child' or 'children', not both", "child")
+        if has_child:
+            if node_type.arity == "many":
+                site.fail(f"{what} takes 'children' (a list of nodes), not 'child'", "child")
+            return [self.node(data["child"], site.file, site.line_of("child"), remap, chain)]
+        if not has_children:
+            need = "exactly one child ('child')" if node_type.arity == "one" else "at least one child ('children')"
+            site.fail(f"{what} needs {need}")
+        items = data["children"]
+        if not isinstance(items, list):
+            site.fail(f"'children' must be a list of nodes, not {_describe(items)}", "children")
+        if node_type.arity == "one" and len(items) != 1:
+            site.fail(f"{what} needs exactly one child, got {len(items)}", "children")
+        if not items:
+            site.fail(f"{what} needs at least one child, got none", "children")
+        out = []
+        for index, item in enumerate(items):
+            item_line = items.item_line(index) if isinstance(items, YamlList) else site.line_of("children")
+            out.append(self.node(item, site.file, item_line, remap, chain))
+        return out
+
+
+def build_tree(
+    data: Mapping[str, Any],
+    ctx: AgentContext,
+    *,
+    file: str | os.PathLike[str] | None = None,
+    remap: Mapping[str, str] | None = None,
+    registry: Registry | None = None,
+) -> Behaviour:
+    """Build the tree whose root node is ``data`` (already parsed, e.g. a tree written
+    inline in a scenario); includes resolve relative to ``file``'s directory."""
+    file_text = os.fspath(file) if file is not None else None
+    builder = _TreeBuilder(ctx, registry or default_registry(), file_text)
+    chain = (os.path.realpath(file_text),) if file_text else ()
+    return builder.node(data, file_text, line_of(data, 1), dict(remap or {}), chain)
+
+
+def load_tree(
+    path: str | os.PathLike[str],
+    ctx: AgentContext,
+    *,
+    remap: Mapping[str, str] | None = None,
+    registry: Registry | None = None,
+) -> Behaviour:
+    """Build the py_trees tree of the YAML file at ``path`` for the agent ``ctx``.
+
+    ``remap`` renames blackboard keys of the whole tree (as an include's remap does).
+
+    Raises:
+        DelveError: any mistake in the file or the files it includes.
+    """
+    file_text = os.fspath(path)
+    builder = _TreeBuilder(ctx, registry or default_registry(), file_text)
+    return builder.file(file_text, dict(remap or {}), (os.path.realpath(file_text),))
+
+
+def _release_blackboard(root: Behaviour) -> None:
+    """Unregister the blackboard clients of a tree built only to be checked."""
+    stack = [root]
+    while stack:
+        node = stack.pop()
+        stack.extend(node.children)
+        condition = getattr(node, "condition_subtree", None)
+        if isinstance(condition, Behaviour):
+            stack.append(condition)
+        for client in node.blackboards:
+            try:
+                client.unregister(clear=False)
+            except KeyError:
+                pass
+
+
+def check_tree(path: str | os.PathLike[str], *, registry: Registry | None = None) -> None:
+    """Check the YAML tree at ``path`` by building it for a dummy agent.
+
+    Raises:
+        DelveError: the first mistake found, with its file, line and node.
+    """
+    root = load_tree(path, check_context(), registry=registry)
+    _release_blackboard(root)

@@ -1,0 +1,140 @@
+"""Exploration skills."""
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from py_trees.common import Status
+
+from ..planners.frontier import FrontierGoal, frontier_clusters, frontier_voxels, nearest_frontier
+from .base import Param, Skill
+from .navigation import navigator
+from .robot import PathStatus
+
+
+class ExploreFrontiers(Skill):
+    """Nearest-frontier exploration: go to the nearest reachable frontier cluster, repeat.
+
+    Frontier voxels (known free next to unknown) of the onboard map are clustered; the
+    cluster whose goal node is nearest along the navigation graph is chosen and the
+    robot follows the path to it. A cluster that is still a frontier after a visit, or
+    whose path is blocked, is blacklisted.
+
+    Writes: ``frontier_goal`` (x, y, z of the current goal), ``frontiers_left`` (clusters).
+    Returns: RUNNING while exploring; SUCCESS when no reachable frontier is left;
+    FAILURE when the robot is not on its own navigation graph.
+    """
+
+    PARAMS = {
+        "cluster_radius_m": Param(float, 0.8, "frontier blocks (2×2×2 voxels) closer than this join", exclusive_minimum=0),
+        "min_cluster_voxels": Param(int, 10, "smaller clusters are ignored", minimum=1),
+        "max_cluster_extent_m": Param(float, 4.0, "larger clusters are split", exclusive_minimum=0),
+        "max_goal_offset_m": Param(float, 12.0, "a goal node is at most this far from its cluster", exclusive_minimum=0),
+        "blacklist_radius_m": Param(float, 2.0, "clusters this close to a failed goal are skipped", minimum=0),
+        "check_period_s": Param(float, 2.0, "how often the target cluster is re-checked", exclusive_minimum=0),
+        "dwell_s": Param(float, 1.0, "time to scan at a goal before judging it", minimum=0),
+        "explored_fraction": Param(float, 0.8, "a cluster this much explored is left", exclusive_minimum=0, maximum=1),
+    }
+
+    def __init__(self, name: str, ctx: Any, remap: dict[str, str] | None = None, **params: Any):
+        super().__init__(name, ctx, remap, **params)
+        self.k_goal = self.key("frontier_goal")
+        self.k_left = self.key("frontiers_left")
+        self.blacklist: list[np.ndarray] = []
+        self.goal: FrontierGoal | None = None
+        self.arrived_s: float | None = None
+        self.checked_s = 0.0
+
+    def initialise(self) -> None:
+        self.goal, self.arrived_s = None, None
+
+    def update(self) -> Status:
+        if self.goal is not None and not self._goal_done():
+            return Status.RUNNING
+        return self._plan()
+
+    def terminate(self, new_status: Status) -> None:
+        if new_status == Status.INVALID and self.ctx.robot is not None:
+            self.robot.stop()
+        self.goal = None
+
+    def _remaining(self) -> int:
+        nav = navigator(self.ctx, self.robot)
+        return len(frontier_voxels(nav.grid(), among=self.goal.cluster.voxels))
+
+    def _goal_done(self) -> bool:
+        """Whether to plan again: goal reached and scanned, blocked, or explored meanwhile."""
+        now, status, goal = self.ctx.clock.now_s, self.robot.path_status, self.goal
+        assert goal is not None
+        if status == PathStatus.FOLLOWING:
+            if now - self.checked_s < self.p["check_period_s"]:
+                return False
+            self.checked_s = now
+            if self._remaining() <= (1 - self.p["explored_fraction"]) * goal.cluster.size:
+                self.robot.stop()
+                return True
+            return False
+        if status == PathStatus.ARRIVED:
+            if self.arrived_s is None:
+                self.arrived_s = now
+            if now - self.arrived_s < self.p["dwell_s"]:
+                return False
+            if self._remaining() > (1 - self.p["explored_fraction"]) * goal.cluster.size:
+                self._blacklist("still a frontier after a visit")
+            return True
+        if status == PathStatus.BLOCKED:
+            self._blacklist(f"path blocked: {getattr(self.robot, 'blocked_reason', '')}")
+        return True
+
+    def _blacklist(self, reason: str) -> None:
+        assert self.goal is not None
+        self.blacklist.append(self.goal.cluster.centroid)
+        self.event("frontier_blacklisted", at=_xyz(self.goal.cluster.centroid), reason=reason)
+
+    def _plan(self) -> Status:
+        self.goal, self.arrived_s = None, None
+        nav = navigator(self.ctx, self.robot)
+        plan = nav.from_robot()
+        if plan is None:
+            self.feedback_message = "robot is not on its navigation graph"
+            self.event("explore_failed", reason=self.feedback_message)
+            return Status.FAILURE
+        grid = nav.grid()
+        clusters = [c for c in frontier_clusters(grid, frontier_voxels(grid),
+                                                 cluster_radius_m=self.p["cluster_radius_m"],
+                                                 min_cluster_voxels=self.p["min_cluster_voxels"],
+                                                 max_extent_m=self.p["max_cluster_extent_m"])
+                    if not self._blacklisted(c.centroid)]
+        self.bb.set(self.k_left, len(clusters))
+        while True:
+            goal = nearest_frontier(plan.graph, plan.distances, clusters, grid,
+                                    max_goal_offset_m=self.p["max_goal_offset_m"])
+            if goal is None:
+                self.feedback_message = "no reachable frontier left"
+                self.event("exploration_complete", blacklisted=len(self.blacklist))
+                return Status.SUCCESS
+            if goal.node != plan.source:
+                break
+            # The robot stands at the goal and still sees a frontier: it cannot observe it.
+            self.goal = goal
+            self._blacklist("unobservable from its goal")
+            clusters = [c for c in clusters if c is not goal.cluster]
+        self.goal, self.checked_s = goal, self.ctx.clock.now_s
+        self.robot.follow_path(plan.path_to(goal.node))
+        self.bb.set(self.k_goal, _xyz(plan.graph.positions[goal.node]))
+        self.feedback_message = f"to frontier {goal.path_length_m:.1f} m away"
+        self.event("frontier_goal", at=_xyz(goal.cluster.centroid), path_length_m=round(goal.path_length_m, 2),
+                   clusters=len(clusters))
+        return Status.RUNNING
+
+    def _blacklisted(self, centroid: np.ndarray) -> bool:
+        if not self.blacklist:
+            return False
+        return bool((np.linalg.norm(np.asarray(self.blacklist) - centroid, axis=1) <= self.p["blacklist_radius_m"]).any())
+
+
+def _xyz(p: np.ndarray) -> list[float]:
+    return [round(float(v), 3) for v in p]
+
+
+__all__ = ["ExploreFrontiers"]

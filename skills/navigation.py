@@ -1,0 +1,112 @@
+"""Path planning on the onboard map, shared by the skills of one robot.
+
+The :class:`Navigator` keeps the navigation graph of the robot's onboard map and the
+shortest-path tree from the robot, and rebuilds them when the map has changed and
+they are older than ``rebuild_period_s`` of sim time, so that several skills ticking
+in one agent do not plan twice.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..planners.navgraph import NavGraph, aerial_graph, legged_graph
+from ..planners.occupancy import Grid
+from .base import AgentContext
+from .robot import Robot
+
+
+@dataclass(frozen=True)
+class Plan:
+    """The graph, the robot's node on it and the shortest-path tree from there."""
+
+    graph: NavGraph
+    source: int
+    distances: np.ndarray
+    predecessors: np.ndarray
+
+    def path_to(self, node: int) -> np.ndarray:
+        return self.graph.path(self.predecessors, node)
+
+
+class Navigator:
+    """Navigation graph and shortest paths from the robot, cached per map version."""
+
+    snap_radii_m = (1.0, 2.0)
+
+    def __init__(self, robot: Robot, ctx: AgentContext, rebuild_period_s: float = 2.0):
+        self.robot = robot
+        self.ctx = ctx
+        self.rebuild_period_s = rebuild_period_s
+        self._graph: NavGraph | None = None
+        self._graph_key: tuple[int, float] | None = None
+        self._plan: Plan | None = None
+        self._plan_key: tuple[int, int] | None = None
+        self.builds = 0
+
+    def grid(self) -> Grid:
+        m = self.robot.onboard_map
+        return Grid(m.occupancy, m.origin, m.voxel_size_m)
+
+    def graph(self, force: bool = False) -> NavGraph:
+        """The navigation graph of the current map (possibly ``rebuild_period_s`` old)."""
+        version, now = self.robot.onboard_map.version, self.ctx.clock.now_s
+        stale = self._graph_key is None or (
+            version != self._graph_key[0] and now - self._graph_key[1] >= self.rebuild_period_s
+        )
+        if force or stale or self._graph is None:
+            mob = self.robot.mobility
+            if mob.aerial:
+                self._graph = aerial_graph(self.grid())
+            else:
+                self._graph = legged_graph(
+                    self.grid(),
+                    body_height_m=mob.body_height_m,
+                    radius_m=mob.radius_m,
+                    max_step_m=mob.max_step_m,
+                    max_inclination_deg=mob.max_inclination_deg,
+                )
+            self._graph_key = (version, now)
+            self.builds += 1
+        return self._graph
+
+    def node_near(self, graph: NavGraph, point: np.ndarray) -> int | None:
+        """The graph node nearest to ``point`` within the snap radii, or None."""
+        for r in self.snap_radii_m:
+            node = graph.nearest(point, r)
+            if node is not None:
+                return node
+        return None
+
+    def from_robot(self, force: bool = False) -> Plan | None:
+        """Shortest paths from the robot's position; None when it is off the graph."""
+        graph = self.graph(force)
+        source = self.node_near(graph, self.robot.position)
+        if source is None:
+            return None
+        key = (id(graph), source)
+        if self._plan is None or self._plan_key != key:
+            dist, pred = graph.shortest_paths(source)
+            self._plan, self._plan_key = Plan(graph, source, dist, pred), key
+        return self._plan
+
+    def path_to_point(self, point: np.ndarray, force: bool = False) -> tuple[np.ndarray | None, float]:
+        """Path from the robot to the node nearest ``point`` and its length (inf if none).
+
+        ``force`` rebuilds the graph from the current map first."""
+        plan = self.from_robot(force=force)
+        if plan is None:
+            return None, float("inf")
+        target = self.node_near(plan.graph, point)
+        if target is None or not np.isfinite(plan.distances[target]):
+            return None, float("inf")
+        return plan.path_to(target), float(plan.distances[target])
+
+
+def navigator(ctx: AgentContext, robot: Robot) -> Navigator:
+    """The agent's shared :class:`Navigator`, created on first use."""
+    nav = ctx.services.get("navigator")
+    if nav is None:
+        nav = ctx.services["navigator"] = Navigator(robot, ctx)
+    return nav
