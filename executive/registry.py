@@ -976,16 +976,52 @@ def describe(registry: Registry | None = None) -> str:
     return "\n".join(lines)
 
 
+DOCS_PATH = Path(__file__).resolve().parent.parent / "docs" / "nodes.md"
+
+
+def reference_markdown(registry: Registry | None = None) -> str:
+    """The node reference (docs/nodes.md): every node type with its parameters."""
+    registry = default_registry() if registry is None else registry
+    out = ["# Node reference", "",
+           f"Every node type a YAML tree can name. Generated from the registry by "
+           f"`python -m delve.executive.registry --write-docs`; do not edit by hand.", ""]
+    titles = {"composite": "Composites", "decorator": "Decorators", "behaviour": "Behaviours",
+              "idiom": "Idioms", "skill": "Skills"}
+    for kind in KINDS:
+        out += [f"## {titles.get(kind, kind)}", ""]
+        for name in registry.names(kind):
+            t = registry[name]
+            kids = {"none": "leaf", "one": "one child (`child`)", "many": "children (`children`)"}[t.arity]
+            cls = t.cls if t.cls is not None and t.kind == "skill" else None
+            doc = inspect.cleandoc(cls.__doc__ or "") if cls is not None else t.doc
+
+            out += [f"### {name}", "", f"*{kind}, {kids}*", "", doc, ""]
+            rows = [(slot, "subtree", "required", d) for slot, d in t.subtrees.items()]
+            rows += [(p, getattr(s.type, "__name__", "any"), "required" if s.required else f"`{s.default!r}`", s.doc)
+                     for p, s in t.params.items()]
+            if rows:
+                out += ["| parameter | type | default | meaning |", "|---|---|---|---|"]
+                out += [f"| `{p}` | {ty} | {d} | {m} |" for p, ty, d, m in rows]
+                out.append("")
+    return "\n".join(out).rstrip() + "\n"
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m delve.executive.registry", description=__doc__.split("\n")[0])
     parser.add_argument("--write-schema", action="store_true", help=f"regenerate {SCHEMA_PATH.name}")
+    parser.add_argument("--write-docs", action="store_true", help="regenerate docs/nodes.md")
     parser.add_argument("--list", action="store_true", help="list node types and their parameters")
     args = parser.parse_args(argv)
     if args.write_schema:
         print(f"wrote {write_schema()}")
-    if args.list or not args.write_schema:
+    if args.write_docs:
+        DOCS_PATH.parent.mkdir(parents=True, exist_ok=True)
+        DOCS_PATH.write_text(reference_markdown(), encoding="utf-8")
+        print(f"wrote {DOCS_PATH}")
+    if args.list or not (args.write_schema or args.write_docs):
         print(describe())
     return 0
+
 
 
 if __name__ == "__main__":

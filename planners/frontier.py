@@ -51,7 +51,8 @@ def frontier_voxels(grid: Grid, among: np.ndarray | None = None, depth: int = 3)
     otherwise observed space.
     """
     flat_occ = grid.occupancy.reshape(-1)
-    flat = np.flatnonzero(flat_occ == FREE) if among is None else among[flat_occ[among] == FREE]
+    flat = grid.free_voxels() if among is None else among[flat_occ[among] == FREE]
+
     free = Voxels(flat, grid.shape)
     is_frontier = np.zeros(len(free), dtype=bool)
     for d in FACES:
@@ -108,7 +109,9 @@ def nearest_frontier(
     *,
     max_goal_offset_m: float,
     offset_weight: float = 2.0,
+    samples_per_cluster: int = 16,
 ) -> FrontierGoal | None:
+
     """The cluster whose goal node is nearest along the graph (``distances`` from the robot).
 
     A cluster's goal is the reachable node that minimises path length plus
@@ -120,8 +123,10 @@ def nearest_frontier(
     reachable = np.flatnonzero(np.isfinite(distances))
     if len(reachable) == 0 or not clusters:
         return None
-    voxels = np.concatenate([c.voxels for c in clusters])
-    owner = np.repeat(np.arange(len(clusters)), [c.size for c in clusters])
+    # Up to ``samples_per_cluster`` voxels of each cluster, evenly spread, stand for it.
+    picks = [c.voxels[:: max(1, c.size // samples_per_cluster)] for c in clusters]
+    voxels = np.concatenate(picks)
+    owner = np.repeat(np.arange(len(clusters)), [len(p) for p in picks])
     pts = grid.to_world(np.stack(np.unravel_index(voxels, grid.shape), axis=1))
     d, i = cKDTree(graph.positions[reachable]).query(pts, distance_upper_bound=max_goal_offset_m)
     ok = np.isfinite(d)

@@ -148,7 +148,8 @@ def legged_graph(
     """
     shape, vox = grid.shape, grid.voxel_size_m
     flat_occ = grid.occupancy.reshape(-1)
-    free = Voxels(np.flatnonzero(flat_occ == FREE), shape)
+    free = Voxels(grid.free_voxels(), shape)
+
     below = free.at(flat_occ, (0, 0, -1), UNKNOWN)
     on_rock = below == OCCUPIED
     stand = on_rock

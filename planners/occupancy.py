@@ -24,6 +24,15 @@ class Grid:
     occupancy: np.ndarray
     origin: np.ndarray
     voxel_size_m: float
+    free: np.ndarray | None = None
+
+    def free_voxels(self) -> np.ndarray:
+        """Flat indices of the FREE voxels: ``free`` when the map keeps them, else
+        found by scanning the grid."""
+        if self.free is not None:
+            return self.free
+        return np.flatnonzero(self.occupancy.reshape(-1) == FREE)
+
 
     @property
     def shape(self) -> tuple[int, int, int]:

@@ -26,6 +26,9 @@ class VoxelMap:
         self.voxel_size_m = float(voxel_size_m)
         self.version = 0
         self._dirty = np.zeros(shape, dtype=bool)
+        self._free = np.zeros(0, dtype=np.int64)
+        self._new_free: list[np.ndarray] = []
+        self._free_stale = False
 
     @property
     def shape(self) -> tuple[int, int, int]:
@@ -69,8 +72,23 @@ class VoxelMap:
         inside = (i >= 0) & (i < nx) & (j >= 0) & (j < ny) & (k >= 0) & (k < nz)
         flat = ((i * ny + j) * nz + k)[inside]
         flat = flat[occ[flat] == only] if only is not None else flat[occ[flat] != value]
+        if value == FREE:
+            self._new_free.append(np.unique(flat))
+        else:
+            self._free_stale = True
         occ[flat] = value
         self._dirty.reshape(-1)[flat] = True
+
+    def free_voxels(self) -> np.ndarray:
+        """Flat indices of the FREE voxels, in the order they became free. Kept up to
+        date as scans arrive, so planners need not scan the whole grid."""
+        if self._new_free:
+            self._free = np.concatenate([self._free, *self._new_free])
+            self._new_free = []
+        if self._free_stale:
+            self._free = self._free[self.occupancy.reshape(-1)[self._free] == FREE]
+            self._free_stale = False
+        return self._free
 
     def take_changes(self) -> tuple[np.ndarray, np.ndarray]:
         """Flat indices and values of the voxels changed since the last call."""
@@ -82,8 +100,12 @@ class VoxelMap:
         """Merge voxels from another map of the same geometry; OCCUPIED wins over FREE."""
         occ = self.occupancy.reshape(-1)
         current = occ[flat]
-        occ[flat] = np.maximum(current, values)
+        merged = np.maximum(current, values)
+        self._new_free.append(flat[(current == UNKNOWN) & (merged == FREE)])
+        self._free_stale = True
+        occ[flat] = merged
         self.version += 1
+
 
     def known_fraction_of(self, flat: np.ndarray) -> float:
         """Fraction of the voxels ``flat`` that this map knows as FREE."""

@@ -14,9 +14,11 @@ from .robot import PathStatus
 class EnduranceLow(Skill):
     """Whether the remaining endurance barely covers the way home.
 
-    The way home is the shortest path on the onboard map from the robot to its home,
-    re-planned every ``check_period_s`` (its straight-line length times
-    ``detour_factor`` while no path is known).
+    The way home is the shortest path on the onboard map from the robot to its home
+    (its straight-line length times ``detour_factor`` while no path is known). It is
+    re-planned at most every ``check_period_s``, and only when the reserve could have
+    run out: the way home grows by at most the distance walked, so the reserve
+    shrinks by at most ``1 + safety_factor`` seconds per second.
 
     Writes: ``time_to_home_s``. Returns SUCCESS when
     ``endurance <= safety_factor * time_to_home + margin_s``, else FAILURE.
@@ -32,26 +34,28 @@ class EnduranceLow(Skill):
     def __init__(self, name: str, ctx: Any, remap: dict[str, str] | None = None, **params: Any):
         super().__init__(name, ctx, remap, **params)
         self.k_time = self.key("time_to_home_s")
-        self.checked_s = -float("inf")
+        self.next_check_s = -float("inf")
         self.time_to_home_s = 0.0
-        self.at_check_endurance_s = 0.0
 
     def update(self) -> Status:
         r, now = self.robot, self.ctx.clock.now_s
-        if now - self.checked_s >= self.p["check_period_s"]:
-            self.checked_s = now
+        sf = self.p["safety_factor"]
+        if now >= self.next_check_s:
             _, length = navigator(self.ctx, r).path_to_point(r.home)
             if not np.isfinite(length):
                 length = float(np.linalg.norm(r.position - r.home)) * self.p["detour_factor"]
             self.time_to_home_s = length / r.mobility.speed_mps
             self.bb.set(self.k_time, round(self.time_to_home_s, 2))
-        needed = self.p["safety_factor"] * self.time_to_home_s + self.p["margin_s"]
+            reserve = r.endurance_remaining_s - (sf * self.time_to_home_s + self.p["margin_s"])
+            self.next_check_s = now + max(self.p["check_period_s"], reserve / (1 + sf))
+        needed = sf * self.time_to_home_s + self.p["margin_s"]
         if r.endurance_remaining_s <= needed:
             self.feedback_message = f"{r.endurance_remaining_s:.0f} s left, home takes {self.time_to_home_s:.0f} s"
-            self.event("endurance_low", endurance_s=round(r.endurance_remaining_s, 1),
+            self.event("endurance_low", trigger=True, endurance_s=round(r.endurance_remaining_s, 1),
                        time_to_home_s=round(self.time_to_home_s, 1))
             return Status.SUCCESS
         return Status.FAILURE
+
 
 
 class ReturnHome(Skill):

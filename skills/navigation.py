@@ -35,7 +35,8 @@ class Navigator:
 
     snap_radii_m = (1.0, 2.0)
 
-    def __init__(self, robot: Robot, ctx: AgentContext, rebuild_period_s: float = 2.0):
+    def __init__(self, robot: Robot, ctx: AgentContext, rebuild_period_s: float = 5.0):
+
         self.robot = robot
         self.ctx = ctx
         self.rebuild_period_s = rebuild_period_s
@@ -47,7 +48,8 @@ class Navigator:
 
     def grid(self) -> Grid:
         m = self.robot.onboard_map
-        return Grid(m.occupancy, m.origin, m.voxel_size_m)
+        return Grid(m.occupancy, m.origin, m.voxel_size_m, m.free_voxels())
+
 
     def graph(self, force: bool = False) -> NavGraph:
         """The navigation graph of the current map (possibly ``rebuild_period_s`` old)."""

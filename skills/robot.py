@@ -54,7 +54,11 @@ class MapView(Protocol):
     def version(self) -> int:
         """Increases each time the map changes, so planners can cache."""
 
+    def free_voxels(self) -> np.ndarray:
+        """Flat indices of the FREE voxels (kept by the map, so no grid scan is needed)."""
+
     def take_changes(self) -> tuple[np.ndarray, np.ndarray]:
+
         """Flat voxel indices and values changed since the last call (for map sharing)."""
 
 

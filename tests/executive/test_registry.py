@@ -273,3 +273,10 @@ def test_schema_records_units_and_descriptions():
     assert timer["type"] == "number" and timer["minimum"] == 0.0 and "seconds" in timer["description"]
     assert defs["type.Sequence"]["properties"]["memory"]["default"] is True
     assert set(defs["typed_node"]["properties"]["type"]["enum"]) == set(default_registry().names())
+
+
+def test_shipped_node_reference_equals_the_generated_one():
+    shipped = reg.DOCS_PATH.read_text(encoding="utf-8")
+    assert shipped == reg.reference_markdown(), (
+        "docs/nodes.md is out of date; regenerate it with `python -m delve.executive.registry --write-docs`"
+    )
