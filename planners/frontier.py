@@ -34,11 +34,13 @@ class FrontierCluster:
 
 @dataclass(frozen=True)
 class FrontierGoal:
-    """The chosen cluster, the graph node to go to and the path length to it."""
+    """The chosen cluster, the graph node to go to, the path length to it and the
+    straight distance from that node to the nearest sampled voxel of the cluster."""
 
     cluster: FrontierCluster
     node: int
     path_length_m: float
+    offset_m: float
 
 
 def frontier_voxels(grid: Grid, among: np.ndarray | None = None, depth: int = 3) -> np.ndarray:
@@ -135,4 +137,6 @@ def nearest_frontier(
     nodes = reachable[i[ok]]
     cost = distances[nodes] + offset_weight * d[ok]
     k = int(np.argmin(cost))
-    return FrontierGoal(cluster=clusters[owner[ok][k]], node=int(nodes[k]), path_length_m=float(distances[nodes[k]]))
+    return FrontierGoal(cluster=clusters[owner[ok][k]], node=int(nodes[k]), path_length_m=float(distances[nodes[k]]),
+                        offset_m=float(d[ok][k]))
+

@@ -179,7 +179,7 @@ def legged_graph(
     positions[:, 2] += body_height_m - 0.5 * vox
     max_dz = max(1, int(math.floor(max_step_m / vox + 1e-9)))
     offsets = [(di, dj, dz) for di, dj in _NEIGHBOURS_8 if (di, dj) > (0, 0) for dz in range(-max_dz, max_dz + 1)]
-    return _graph(nodes, positions, offsets, vox)
+    return _graph(nodes, positions, offsets, vox, side_steps=max_dz)
 
 
 def _same_height_near(ground: np.ndarray, query: np.ndarray, radius_cells: float) -> np.ndarray:
@@ -214,35 +214,60 @@ def _inclination_deg(cand: Voxels, vox: float, limit_deg: float, baseline_m: flo
     return np.degrees(np.arctan(np.hypot(grads[0], grads[1])))
 
 
-def aerial_graph(grid: Grid, *, block: int = 2) -> NavGraph:
-    """Graph of ``block``³ blocks of known free voxels, 26-connected, with a one-block
-    margin to any rock, so a flying robot keeps clear of walls."""
-    occ = grid.occupancy
-    nb = tuple(s // block for s in occ.shape)
-    cropped = occ[: nb[0] * block, : nb[1] * block, : nb[2] * block]
-    blocks = cropped.reshape(nb[0], block, nb[1], block, nb[2], block)
-    all_free = (blocks == FREE).all(axis=(1, 3, 5))
-    rock = (blocks == OCCUPIED).any(axis=(1, 3, 5)).reshape(-1)
-    free = Voxels(np.flatnonzero(all_free), nb)
-    keep = np.ones(len(free), dtype=bool)
-    for d in FACES:
-        keep &= ~free.at(rock, d, True)
-    nodes = free.subset(keep)
-    positions = grid.origin + (nodes.ijk + 0.5) * block * grid.voxel_size_m
-    offsets = [(a, b, c) for a in (-1, 0, 1) for b in (-1, 0, 1) for c in (-1, 0, 1) if (a, b, c) > (0, 0, 0)]
-    return _graph(nodes, positions, offsets, block * grid.voxel_size_m)
+def aerial_graph(grid: Grid, *, radius_m: float, stride: int = 2) -> NavGraph:
+    """Graph of known-free voxels on a lattice of every ``stride``-th voxel, 26-connected,
+    keeping only those with no rock within ``radius_m`` (the robot's body), so a flying
+    robot passes squeezes just wider than itself."""
+    flat_occ = grid.occupancy.reshape(-1)
+    free = Voxels(grid.free_voxels(), grid.shape)
+    on_lattice = np.all(free.ijk % stride == 0, axis=1)
+    nodes = free.subset(on_lattice)
+    r = max(1, math.ceil(radius_m / grid.voxel_size_m))
+    keep = np.ones(len(nodes), dtype=bool)
+    for d in _ball(r):
+        keep &= nodes.at(flat_occ, d, OCCUPIED) != OCCUPIED
+    nodes = nodes.subset(keep)
+    positions = grid.to_world(nodes.ijk)
+    offsets = [(a * stride, b * stride, c * stride) for a in (-1, 0, 1) for b in (-1, 0, 1) for c in (-1, 0, 1)
+               if (a, b, c) > (0, 0, 0)]
+    return _graph(nodes, positions, offsets, grid.voxel_size_m)
 
 
-def _graph(nodes: Voxels, positions: np.ndarray, offsets: list[tuple[int, int, int]], cell_m: float) -> NavGraph:
-    """Connect nodes to the nodes at ``offsets`` (each undirected edge once)."""
+def _ball(r: int) -> list[tuple[int, int, int]]:
+    """Offsets within ``r`` voxels of the origin, the origin excluded."""
+    span = range(-r, r + 1)
+    return [(a, b, c) for a in span for b in span for c in span if 0 < a * a + b * b + c * c <= r * r]
+
+
+def _graph(nodes: Voxels, positions: np.ndarray, offsets: list[tuple[int, int, int]], cell_m: float,
+           side_steps: int | None = None) -> NavGraph:
+    """Connect nodes to the nodes at ``offsets`` (each undirected edge once).
+
+    With ``side_steps``, a horizontal diagonal edge also needs a node beside it on
+    both sides (within ``side_steps`` voxels of height), so that no edge cuts the
+    corner of a wall or a ledge.
+    """
     rows, cols, w = [], [], []
     with _Lookup(int(np.prod(nodes.shape)), nodes.flat) as ids:
+        sides: dict[tuple[int, int], np.ndarray] = {}
+
+        def beside(di: int, dj: int) -> np.ndarray:
+            if (di, dj) not in sides:
+                sides[(di, dj)] = np.logical_or.reduce(
+                    [nodes.at(ids, (di, dj, dz), -1) >= 0 for dz in range(-side_steps, side_steps + 1)])
+            return sides[(di, dj)]
+
         for d in offsets:
             tgt = nodes.at(ids, d, -1)
-            src = np.flatnonzero(tgt >= 0)
+            ok = tgt >= 0
+            if side_steps is not None and d[0] and d[1]:
+                ok &= beside(d[0], 0) & beside(0, d[1])
+            src = np.flatnonzero(ok)
+
             rows.append(src)
             cols.append(tgt[src])
             w.append(np.full(len(src), cell_m * math.sqrt(d[0] ** 2 + d[1] ** 2 + d[2] ** 2)))
+
     n = len(positions)
     adj = csr_matrix((np.concatenate(w), (np.concatenate(rows), np.concatenate(cols))), shape=(n, n))
     return NavGraph(positions=positions, adjacency=adj)

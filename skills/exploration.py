@@ -30,8 +30,12 @@ class ExploreFrontiers(Skill):
         "min_cluster_voxels": Param(int, 10, "smaller clusters are ignored", minimum=1),
         "max_cluster_extent_m": Param(float, 4.0, "larger clusters are split", exclusive_minimum=0),
         "max_goal_offset_m": Param(float, 12.0, "a goal node is at most this far from its cluster", exclusive_minimum=0),
-        "blacklist_radius_m": Param(float, 2.0, "clusters this close to a failed goal are skipped", minimum=0),
-        "check_period_s": Param(float, 2.0, "how often the target cluster is re-checked", exclusive_minimum=0),
+        "blacklisted_fraction": Param(float, 0.5, "clusters with this share of blacklisted voxels are skipped",
+                                      exclusive_minimum=0, maximum=1),
+        "observe_radius_m": Param(float, 3.0, "a frontier this near that stays one is unobservable",
+                                  exclusive_minimum=0),
+        "check_period_s": Param(
+float, 2.0, "how often the target cluster is re-checked", exclusive_minimum=0),
         "dwell_s": Param(float, 1.0, "time to scan at a goal before judging it", minimum=0),
         "explored_fraction": Param(float, 0.8, "a cluster this much explored is left", exclusive_minimum=0, maximum=1),
     }
@@ -40,7 +44,7 @@ class ExploreFrontiers(Skill):
         super().__init__(name, ctx, remap, **params)
         self.k_goal = self.key("frontier_goal")
         self.k_left = self.key("frontiers_left")
-        self.blacklist: list[np.ndarray] = []
+        self.blacklist = np.zeros(0, dtype=np.int64)
         self.goal: FrontierGoal | None = None
         self.arrived_s: float | None = None
         self.checked_s = 0.0
@@ -88,7 +92,7 @@ class ExploreFrontiers(Skill):
 
     def _blacklist(self, reason: str) -> None:
         assert self.goal is not None
-        self.blacklist.append(self.goal.cluster.centroid)
+        self.blacklist = np.union1d(self.blacklist, self.goal.cluster.voxels)
         self.event("frontier_blacklisted", at=_xyz(self.goal.cluster.centroid), reason=reason)
 
     def _plan(self) -> Status:
@@ -104,20 +108,22 @@ class ExploreFrontiers(Skill):
                                                  cluster_radius_m=self.p["cluster_radius_m"],
                                                  min_cluster_voxels=self.p["min_cluster_voxels"],
                                                  max_extent_m=self.p["max_cluster_extent_m"])
-                    if not self._blacklisted(c.centroid)]
+                    if not self._blacklisted(c.voxels)]
         self.bb.set(self.k_left, len(clusters))
         while True:
             goal = nearest_frontier(plan.graph, plan.distances, clusters, grid,
                                     max_goal_offset_m=self.p["max_goal_offset_m"])
             if goal is None:
                 self.feedback_message = "no reachable frontier left"
-                self.event("exploration_complete", blacklisted=len(self.blacklist))
+                self.event("exploration_complete", blacklisted_voxels=len(self.blacklist))
                 return Status.SUCCESS
             if goal.node != plan.source:
                 break
-            # The robot stands at the goal and still sees a frontier: it cannot observe it.
-            self.goal = goal
-            self._blacklist("unobservable from its goal")
+            if goal.offset_m <= self.p["observe_radius_m"]:
+                # The robot stands next to the frontier and still sees it: it never will.
+                self.goal = goal
+                self._blacklist("unobservable from its goal")
+            # Otherwise the map does not reach any nearer yet: skip it this time.
             clusters = [c for c in clusters if c is not goal.cluster]
         self.goal, self.checked_s = goal, self.ctx.clock.now_s
         self.robot.follow_path(plan.path_to(goal.node))
@@ -127,10 +133,10 @@ class ExploreFrontiers(Skill):
                    clusters=len(clusters))
         return Status.RUNNING
 
-    def _blacklisted(self, centroid: np.ndarray) -> bool:
-        if not self.blacklist:
-            return False
-        return bool((np.linalg.norm(np.asarray(self.blacklist) - centroid, axis=1) <= self.p["blacklist_radius_m"]).any())
+    def _blacklisted(self, voxels: np.ndarray) -> bool:
+        """Whether enough of a cluster's voxels belong to clusters that failed before."""
+        return np.isin(voxels, self.blacklist, assume_unique=True).mean() >= self.p["blacklisted_fraction"]
+
 
 
 def _xyz(p: np.ndarray) -> list[float]:

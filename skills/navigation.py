@@ -60,7 +60,8 @@ class Navigator:
         if force or stale or self._graph is None:
             mob = self.robot.mobility
             if mob.aerial:
-                self._graph = aerial_graph(self.grid())
+                self._graph = aerial_graph(self.grid(), radius_m=mob.radius_m)
+
             else:
                 self._graph = legged_graph(
                     self.grid(),

@@ -62,10 +62,11 @@ def test_unknown_space_is_not_walkable():
 
 def test_aerial_graph_keeps_a_margin_and_connects():
     grid = corridor()
-    g = aerial_graph(grid, block=2)
+    g = aerial_graph(grid, radius_m=0.4)
     assert len(g) > 0
     src, dst = np.argmin(g.positions[:, 0]), np.argmax(g.positions[:, 0])
     dist, _ = g.shortest_paths(int(src))
     assert np.isfinite(dist[dst])
-    # one free block between any node and rock
-    assert g.positions[:, 1].min() > 3 * VOX + 0.4
+    # no rock within the body radius of any node
+    assert g.positions[:, 1].min() >= 3 * VOX + 0.4
+

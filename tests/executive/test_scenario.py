@@ -1,0 +1,53 @@
+"""Scenario files: the shipped ones validate; each malformed one gives its one-line error."""
+from pathlib import Path
+
+import pytest
+
+from delve import SCENARIOS_DIR
+from delve.executive.cli import main
+from delve.executive.errors import DelveError
+from delve.executive.scenario import load_scenario
+
+CORPUS = Path(__file__).parent.parent / "data" / "malformed_scenarios"
+CASES = sorted(p for p in CORPUS.glob("*.yaml") if p.read_text().startswith("# expect:"))
+
+
+def header(path: Path, key: str) -> str | None:
+    for line in path.read_text().splitlines():
+        if line.startswith(f"# {key}:"):
+            return line.split(":", 1)[1].strip()
+    return None
+
+
+@pytest.mark.parametrize("case", CASES, ids=[c.stem for c in CASES])
+def test_malformed_scenario_gives_one_line_with_file_and_line(case, capsys):
+    assert main(["validate", str(case)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "Traceback" not in err
+    where = CORPUS / (header(case, "file") or case.name)
+    assert err.startswith(f"{where}:{header(case, 'line')}:") or err.startswith(
+        f"{where.relative_to(Path.cwd()) if where.is_relative_to(Path.cwd()) else where}:{header(case, 'line')}:"
+    ), err
+    assert header(case, "expect") in err
+
+
+def test_corpus_is_large_enough():
+    assert len(CASES) >= 12
+
+
+@pytest.mark.parametrize("path", sorted(SCENARIOS_DIR.glob("*.yaml")), ids=lambda p: p.stem)
+def test_shipped_scenarios_load(path):
+    scenario = load_scenario(path)
+    assert scenario.robots and scenario.duration_s > 0
+
+
+def test_run_rejects_bad_overrides(capsys):
+    assert main(["run", str(SCENARIOS_DIR / "demo.yaml"), "--duration-s", "-1", "--quiet"]) == 2
+    assert "--duration-s must be > 0" in capsys.readouterr().err
+
+
+def test_load_errors_are_delve_errors(tmp_path):
+    bad = tmp_path / "x.yaml"
+    bad.write_text("- just\n- a list\n")
+    with pytest.raises(DelveError, match="must be a mapping"):
+        load_scenario(bad)
