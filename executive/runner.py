@@ -139,7 +139,9 @@ class Mission:
             self._sense(now)
             self.radio.update()
             for agent in self.agents.values():
-                agent.tick_if_due(now)
+                if agent.tick_if_due(now) and agent.finished and agent.name in self.robots:
+                    self.robots[agent.name].park()
+
             if now + 1e-9 >= next_sample:
                 self._sample(now)
                 next_sample = now + self.scenario.coverage_period_s

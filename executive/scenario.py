@@ -43,6 +43,7 @@ class RobotSpec:
     overrides: dict[str, float] = field(default_factory=dict)
     lidar: dict[str, float] = field(default_factory=dict)
     line: int | None = None
+    start_line: int | None = None
 
 
 @dataclass
@@ -89,7 +90,7 @@ class Scenario:
                 continue
             problem = world.start_problem(r.start)
             if problem:
-                raise DelveError(f"robot {r.name!r}: start pose {r.start} is {problem}", self.path, r.line)
+                raise DelveError(f"robot {r.name!r}: start pose {r.start} is {problem}", self.path, r.start_line)
         if self.base_position is not None:
             problem = world.start_problem(self.base_position)
             if problem:
@@ -172,7 +173,9 @@ def load_scenario(path: str | Path) -> Scenario:
         extra = {k: float(r[k]) for k in ("speed_mps", "max_inclination_deg", "max_step_m") if k in r}
         robots.append(RobotSpec(name=r["name"], platform=r["platform"], tree=tree, start=r.get("start"),
                                 endurance_s=r.get("endurance_s"), tick_hz=float(r.get("tick_hz", 5.0)),
-                                overrides=extra, lidar=plain(r.get("lidar", {})), line=line))
+                                overrides=extra, lidar=plain(r.get("lidar", {})), line=line,
+                                start_line=r.key_line("start")))
+
     base = doc.get("base_station", {})
     base_tree = None
     if "tree" in base:

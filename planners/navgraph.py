@@ -96,6 +96,26 @@ class Voxels:
         self.margin = margin
         self._near: dict[int, np.ndarray] = {}
 
+    _last_free: tuple[np.ndarray, "Voxels"] | None = None
+
+    @classmethod
+    def free_of(cls, grid: Grid) -> "Voxels":
+        """The grid's FREE voxels. A map that keeps its free voxels only appends to
+        them between scans, so the last result is reused and extended by the new tail."""
+        flat = grid.free_voxels()
+        last = cls._last_free
+        if last is not None and last[0] is flat:
+            return last[1]
+        n = len(last[0]) if last is not None else 0
+        if last is not None and last[1].shape == grid.shape and 0 < n <= len(flat) and np.array_equal(last[0], flat[:n]):
+            tail = Voxels(flat[n:], grid.shape)
+            old = last[1]
+            voxels = Voxels(flat, grid.shape, np.concatenate([old.ijk, tail.ijk]), np.concatenate([old.margin, tail.margin]))
+        else:
+            voxels = Voxels(flat, grid.shape)
+        cls._last_free = (flat, voxels)
+        return voxels
+
     def __len__(self) -> int:
         return len(self.flat)
 
@@ -108,20 +128,22 @@ class Voxels:
             self._near[r] = np.flatnonzero(self.margin < r)
         return self._near[r]
 
-    def at(self, values: np.ndarray, d: tuple[int, int, int], outside: int) -> np.ndarray:
-        """``values`` (a flat array over the grid) at offset ``d`` from each voxel;
-        ``outside`` where that falls beyond the grid."""
+    def at(self, values: np.ndarray, d: tuple[int, int, int], outside: int, idx: np.ndarray | None = None) -> np.ndarray:
+        """``values`` (a flat array over the grid) at offset ``d`` from each voxel, or
+        from the voxels ``idx`` (positions in this set); ``outside`` beyond the grid."""
         step = (d[0] * self.shape[1] + d[1]) * self.shape[2] + d[2]
-        near = self._near_boundary(max(abs(d[0]), abs(d[1]), abs(d[2])))
+        r = max(abs(d[0]), abs(d[1]), abs(d[2]))
+        flat = self.flat if idx is None else self.flat[idx]
+        near = self._near_boundary(r) if idx is None else np.flatnonzero(self.margin[idx] < r)
         if len(near) == 0:
-            return values[self.flat + step]
-        target = self.flat + step
+            return values[flat + step]
+        target = flat + step
         target[near] = 0
         out = values[target]
-        t = self.ijk[near] + np.array(d)
+        t = (self.ijk if idx is None else self.ijk[idx])[near] + np.array(d)
         ok = np.all((t >= 0) & (t < np.array(self.shape)), axis=1)
         out[near] = outside
-        out[near[ok]] = values[self.flat[near[ok]] + step]
+        out[near[ok]] = values[flat[near[ok]] + step]
         return out
 
 
@@ -148,7 +170,7 @@ def legged_graph(
     """
     shape, vox = grid.shape, grid.voxel_size_m
     flat_occ = grid.occupancy.reshape(-1)
-    free = Voxels(grid.free_voxels(), shape)
+    free = Voxels.free_of(grid)
 
     below = free.at(flat_occ, (0, 0, -1), UNKNOWN)
     on_rock = below == OCCUPIED
@@ -219,7 +241,7 @@ def aerial_graph(grid: Grid, *, radius_m: float, stride: int = 2) -> NavGraph:
     keeping only those with no rock within ``radius_m`` (the robot's body), so a flying
     robot passes squeezes just wider than itself."""
     flat_occ = grid.occupancy.reshape(-1)
-    free = Voxels(grid.free_voxels(), grid.shape)
+    free = Voxels.free_of(grid)
     on_lattice = np.all(free.ijk % stride == 0, axis=1)
     nodes = free.subset(on_lattice)
     r = max(1, math.ceil(radius_m / grid.voxel_size_m))

@@ -66,6 +66,8 @@ class SimRobot:
         self._status = IDLE
         self.blocked_reason = ""
         self._scans = 0
+        self._parked = False
+
         self._sensors = [(spec, spec.beam_directions(0.0)) for spec in (platform.lidar, platform.terrain) if spec]
 
     # ---- the robot interface -------------------------------------------------
@@ -121,6 +123,11 @@ class SimRobot:
     def alive(self) -> bool:
         return self._endurance > 0
 
+    def park(self) -> None:
+        """Stop and power down: endurance no longer counts down (the mission is over)."""
+        self.stop()
+        self._parked = True
+
     def follow_path(self, path: np.ndarray) -> None:
         path = np.asarray(path, dtype=float).reshape(-1, 3)
         if len(path) == 0 or not np.all(np.isfinite(path)):
@@ -136,7 +143,7 @@ class SimRobot:
     # ---- simulation ------------------------------------------------------------
     def step(self, dt_s: float) -> None:
         """Advance endurance and motion by one sim step."""
-        if not self.alive:
+        if not self.alive or self._parked:
             return
         self._endurance = max(0.0, self._endurance - dt_s)
         if self._endurance == 0.0:

@@ -17,8 +17,8 @@ class ExploreFrontiers(Skill):
 
     Frontier voxels (known free next to unknown) of the onboard map are clustered; the
     cluster whose goal node is nearest along the navigation graph is chosen and the
-    robot follows the path to it. A cluster that is still a frontier after a visit, or
-    whose path is blocked, is blacklisted.
+    robot follows the path to it. The voxels of a cluster that is still a frontier
+    after a visit, or whose path is blocked, are blacklisted: never goals again.
 
     Writes: ``frontier_goal`` (x, y, z of the current goal), ``frontiers_left`` (clusters).
     Returns: RUNNING while exploring; SUCCESS when no reachable frontier is left;
@@ -30,8 +30,6 @@ class ExploreFrontiers(Skill):
         "min_cluster_voxels": Param(int, 10, "smaller clusters are ignored", minimum=1),
         "max_cluster_extent_m": Param(float, 4.0, "larger clusters are split", exclusive_minimum=0),
         "max_goal_offset_m": Param(float, 12.0, "a goal node is at most this far from its cluster", exclusive_minimum=0),
-        "blacklisted_fraction": Param(float, 0.5, "clusters with this share of blacklisted voxels are skipped",
-                                      exclusive_minimum=0, maximum=1),
         "observe_radius_m": Param(float, 3.0, "a frontier this near that stays one is unobservable",
                                   exclusive_minimum=0),
         "check_period_s": Param(
@@ -104,11 +102,11 @@ float, 2.0, "how often the target cluster is re-checked", exclusive_minimum=0),
             self.event("explore_failed", reason=self.feedback_message)
             return Status.FAILURE
         grid = nav.grid()
-        clusters = [c for c in frontier_clusters(grid, frontier_voxels(grid),
-                                                 cluster_radius_m=self.p["cluster_radius_m"],
-                                                 min_cluster_voxels=self.p["min_cluster_voxels"],
-                                                 max_extent_m=self.p["max_cluster_extent_m"])
-                    if not self._blacklisted(c.voxels)]
+        candidates = frontier_voxels(grid)
+        candidates = candidates[~np.isin(candidates, self.blacklist)]
+        clusters = frontier_clusters(grid, candidates, cluster_radius_m=self.p["cluster_radius_m"],
+                                     min_cluster_voxels=self.p["min_cluster_voxels"],
+                                     max_extent_m=self.p["max_cluster_extent_m"])
         self.bb.set(self.k_left, len(clusters))
         while True:
             goal = nearest_frontier(plan.graph, plan.distances, clusters, grid,
@@ -132,11 +130,6 @@ float, 2.0, "how often the target cluster is re-checked", exclusive_minimum=0),
         self.event("frontier_goal", at=_xyz(goal.cluster.centroid), path_length_m=round(goal.path_length_m, 2),
                    clusters=len(clusters))
         return Status.RUNNING
-
-    def _blacklisted(self, voxels: np.ndarray) -> bool:
-        """Whether enough of a cluster's voxels belong to clusters that failed before."""
-        return np.isin(voxels, self.blacklist, assume_unique=True).mean() >= self.p["blacklisted_fraction"]
-
 
 
 def _xyz(p: np.ndarray) -> list[float]:

@@ -1,0 +1,296 @@
+"""Ground-truth worlds: a voxel grid of free space plus the rock surface mesh.
+
+A :class:`World` is what the simulator knows and the robots do not: which
+voxels are air (``free``), the rock surface (``mesh``) that LiDAR rays hit,
+the passages' centreline graph and a default start point on the floor.
+Worlds come from :mod:`delve.sim.worldgen` (procedural mines and caves, or a
+mesh file); this module only queries them.
+
+Conventions: world coordinates in metres, +z up; voxel ``(i, j, k)`` spans
+``origin + [i, i+1) * voxel_size_m`` (and likewise in y and z); everything
+outside the grid counts as rock.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import networkx as nx
+import numpy as np
+import open3d as o3d
+from scipy import ndimage
+
+#: 26-connectivity structuring element for scipy.ndimage.label.
+_CONNECTIVITY_26 = np.ones((3, 3, 3), dtype=bool)
+#: Radius within which reachable_free looks for a free voxel near the start.
+_START_SEARCH_RADIUS_M = 1.0
+#: Default start points sit this far above the floor surface, inside the first free voxel.
+START_ABOVE_FLOOR_M = 0.01
+#: Mesh file suffixes that save_mesh and worldgen.from_mesh understand.
+MESH_SUFFIXES = (".ply", ".obj", ".stl")
+
+
+@dataclass(kw_only=True, eq=False)
+class World:
+    """A ground-truth world: voxel free space, rock mesh, centreline, start.
+
+    Fields:
+        name: a short label (scenario files and reports use it).
+        voxel_size_m: edge length of a voxel.
+        origin: (3,) world coordinates of the lower corner of voxel (0, 0, 0).
+        free: bool (nx, ny, nz); True = air, False = rock (or outside).
+        mesh: the rock surface (legacy open3d TriangleMesh), for ray casting
+            and plots; in generated worlds its normals point into free space.
+        centreline: networkx.Graph; nodes carry ``pos`` (a point on the floor)
+            and ``level``; edges carry ``width_m``, ``height_m``, ``kind``
+            ("tunnel", "cave", "ramp" or "shaft") and ``length_m``. Empty for
+            worlds loaded from a mesh.
+        start: (3,) default start point on the floor.
+    """
+
+    name: str
+    voxel_size_m: float = 0.2
+    origin: np.ndarray
+    free: np.ndarray
+    mesh: o3d.geometry.TriangleMesh
+    centreline: nx.Graph = field(default_factory=nx.Graph)
+    start: np.ndarray
+
+    _scene: o3d.t.geometry.RaycastingScene | None = field(
+        default=None, init=False, repr=False)
+    _labels: np.ndarray | None = field(default=None, init=False, repr=False)
+    _reachable: dict = field(default_factory=dict, init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        self.voxel_size_m = float(self.voxel_size_m)
+        if not np.isfinite(self.voxel_size_m) or self.voxel_size_m <= 0:
+            raise ValueError(f"voxel_size_m must be > 0, got {self.voxel_size_m}")
+        self.origin = np.asarray(self.origin, dtype=float).reshape(3)
+        self.start = np.asarray(self.start, dtype=float).reshape(3)
+        self.free = np.asarray(self.free, dtype=bool)
+        if self.free.ndim != 3:
+            raise ValueError(f"free must be a 3-D grid, got shape {self.free.shape}")
+
+    def __getstate__(self) -> dict:
+        """Pickle / deepcopy support: the mesh travels as arrays, caches are dropped."""
+        state = self.__dict__.copy()
+        mesh = state.pop("mesh")
+        state["_mesh_arrays"] = (np.asarray(mesh.vertices).copy(),
+                                 np.asarray(mesh.triangles).copy())
+        state.update(_scene=None, _labels=None, _reachable={})
+        return state
+
+    def __setstate__(self, state: dict) -> None:
+        """Rebuild the open3d mesh from the pickled arrays."""
+        state = dict(state)
+        verts, tris = state.pop("_mesh_arrays")
+        mesh = o3d.geometry.TriangleMesh(o3d.utility.Vector3dVector(verts),
+                                         o3d.utility.Vector3iVector(tris))
+        if len(tris):
+            mesh.compute_vertex_normals()
+        state["mesh"] = mesh
+        self.__dict__.update(state)
+
+    def __repr__(self) -> str:
+        return (f"World(name={self.name!r}, voxel_size_m={self.voxel_size_m}, "
+                f"shape={self.shape}, free_voxels={int(self.free.sum())}, "
+                f"triangles={len(self.mesh.triangles)}, "
+                f"centreline={self.centreline.number_of_nodes()} nodes)")
+
+    # ------------------------------------------------------------------ grid
+    @property
+    def shape(self) -> tuple[int, int, int]:
+        """Grid shape (nx, ny, nz) in voxels."""
+        return tuple(int(n) for n in self.free.shape)
+
+    @property
+    def bounds_min(self) -> np.ndarray:
+        """World coordinates of the grid's lower corner."""
+        return self.origin.copy()
+
+    @property
+    def bounds_max(self) -> np.ndarray:
+        """World coordinates of the grid's upper corner."""
+        return self.origin + np.asarray(self.shape, dtype=float) * self.voxel_size_m
+
+    @property
+    def free_volume_m3(self) -> float:
+        """Total free (air) volume of the grid in cubic metres."""
+        return float(np.count_nonzero(self.free)) * self.voxel_size_m ** 3
+
+    def to_index(self, points: np.ndarray) -> np.ndarray:
+        """Voxel indices (N, 3) int of world points (N, 3): floor((p - origin) / voxel)."""
+        p = np.asarray(points, dtype=float).reshape(-1, 3)
+        return np.floor((p - self.origin) / self.voxel_size_m).astype(np.int64)
+
+    def in_bounds(self, idx: np.ndarray) -> np.ndarray:
+        """(N,) bool: which voxel indices (N, 3) lie inside the grid."""
+        i = np.asarray(idx).reshape(-1, 3)
+        return np.all((i >= 0) & (i < np.asarray(self.shape)), axis=1)
+
+    def index_to_center(self, idx: np.ndarray) -> np.ndarray:
+        """World coordinates (N, 3) of the centres of voxels (N, 3)."""
+        i = np.asarray(idx, dtype=float).reshape(-1, 3)
+        return self.origin + (i + 0.5) * self.voxel_size_m
+
+    def is_free(self, points: np.ndarray) -> np.ndarray:
+        """(N,) bool: which world points (N, 3) lie in free space (False outside the grid)."""
+        idx = self.to_index(points)
+        ok = self.in_bounds(idx)
+        out = np.zeros(len(idx), dtype=bool)
+        j = idx[ok]
+        out[ok] = self.free[j[:, 0], j[:, 1], j[:, 2]]
+        return out
+
+    # ---------------------------------------------------------- ray casting
+    @property
+    def scene(self) -> o3d.t.geometry.RaycastingScene:
+        """Cached open3d RaycastingScene holding the rock mesh."""
+        if self._scene is None:
+            scene = o3d.t.geometry.RaycastingScene()
+            if len(self.mesh.triangles) > 0:
+                scene.add_triangles(o3d.t.geometry.TriangleMesh.from_legacy(self.mesh))
+            self._scene = scene
+        return self._scene
+
+    def cast_rays(self, origins: np.ndarray, directions: np.ndarray,
+                  max_range_m: float) -> np.ndarray:
+        """Distance along each ray to the first rock hit.
+
+        origins, directions: (N, 3); directions must be unit vectors.
+        Returns (N,) float32 distances, np.inf where nothing is hit within
+        ``max_range_m``.
+        """
+        o = np.asarray(origins, dtype=np.float32).reshape(-1, 3)
+        d = np.asarray(directions, dtype=np.float32).reshape(-1, 3)
+        if len(o) != len(d):
+            raise ValueError(f"{len(o)} origins but {len(d)} directions")
+        if len(o) == 0:
+            return np.zeros(0, dtype=np.float32)
+        rays = o3d.core.Tensor(np.ascontiguousarray(np.concatenate([o, d], axis=1)))
+        t = self.scene.cast_rays(rays)["t_hit"].numpy()
+        t[~(t <= np.float32(max_range_m))] = np.inf
+        return t
+
+    def line_of_sight(self, a: np.ndarray, b: np.ndarray) -> bool:
+        """True when no rock lies on the straight segment from a to b."""
+        a = np.asarray(a, dtype=float).reshape(3)
+        b = np.asarray(b, dtype=float).reshape(3)
+        length = float(np.linalg.norm(b - a))
+        if length == 0.0:
+            return True
+        hit = self.cast_rays(a[None], ((b - a) / length)[None], length)
+        return bool(np.isinf(hit[0]))
+
+    # -------------------------------------------------------- connectivity
+    def _nearest_free_voxel(self, point: np.ndarray) -> np.ndarray:
+        """Index of the free voxel nearest to point within 1 m; ValueError if none."""
+        v = self.voxel_size_m
+        centre = self.to_index(point)[0]
+        r = int(np.ceil(_START_SEARCH_RADIUS_M / v))
+        rng = np.arange(-r, r + 1)
+        off = np.stack(np.meshgrid(rng, rng, rng, indexing="ij"), -1).reshape(-1, 3)
+        idx = centre + off
+        dist = np.linalg.norm(self.index_to_center(idx) - np.asarray(point, float), axis=1)
+        keep = (dist <= _START_SEARCH_RADIUS_M + 0.5 * np.sqrt(3) * v) & self.in_bounds(idx)
+        idx, dist = idx[keep], dist[keep]
+        ok = self.free[idx[:, 0], idx[:, 1], idx[:, 2]]
+        if not ok.any():
+            raise ValueError(
+                f"no free voxel within {_START_SEARCH_RADIUS_M} m of "
+                f"{np.round(np.asarray(point, float), 2).tolist()} in world {self.name!r}")
+        idx, dist = idx[ok], dist[ok]
+        order = np.lexsort((idx[:, 2], idx[:, 1], idx[:, 0], dist))
+        return idx[order[0]]
+
+    def reachable_free(self, start: np.ndarray) -> np.ndarray:
+        """Free space connected (26-connectivity) to the voxel at ``start``.
+
+        If that voxel is rock, the nearest free voxel within 1 m is used;
+        ValueError if there is none. Returns a read-only bool grid, cached per
+        start voxel.
+        """
+        start = np.asarray(start, dtype=float).reshape(3)
+        idx = self.to_index(start)[0]
+        if not (self.in_bounds(idx[None])[0] and self.free[tuple(idx)]):
+            idx = self._nearest_free_voxel(start)
+        key = tuple(int(i) for i in idx)
+        if key not in self._reachable:
+            if self._labels is None:
+                labels, n = ndimage.label(self.free, structure=_CONNECTIVITY_26)
+                dtype = np.min_scalar_type(n)
+                self._labels = labels.astype(dtype, copy=False)
+            comp = self._labels == self._labels[key]
+            comp.flags.writeable = False
+            self._reachable[key] = comp
+        return self._reachable[key]
+
+    # --------------------------------------------------------------- ground
+    def ground_height(self, points: np.ndarray, max_drop_m: float) -> np.ndarray:
+        """z of the ground under each point (N, 3), searching down at most max_drop_m.
+
+        The ground is the top surface of the first rock voxel met going down
+        from the point's own voxel. np.nan where there is none within
+        ``max_drop_m`` (e.g. over a shaft), where the point itself is in rock,
+        or where the point is outside the grid.
+        """
+        p = np.asarray(points, dtype=float).reshape(-1, 3)
+        v = self.voxel_size_m
+        n_down = max(int(np.ceil(max(float(max_drop_m), 0.0) / v)) + 1, 1)
+        idx = self.to_index(p)
+        nx_, ny_, nz_ = self.shape
+        col_ok = ((idx[:, 0] >= 0) & (idx[:, 0] < nx_) & (idx[:, 1] >= 0)
+                  & (idx[:, 1] < ny_) & (idx[:, 2] >= 0) & (idx[:, 2] < nz_))
+        out = np.full(len(p), np.nan)
+        if not col_ok.any():
+            return out
+        i, j, k = idx[col_ok, 0], idx[col_ok, 1], idx[col_ok, 2]
+        ks = k[:, None] - np.arange(n_down + 1)[None, :]          # (M, n+1) downward
+        inside = ks >= 0
+        free = np.zeros(ks.shape, dtype=bool)                      # below the grid = rock
+        free[inside] = self.free[np.broadcast_to(i[:, None], ks.shape)[inside],
+                                 np.broadcast_to(j[:, None], ks.shape)[inside],
+                                 ks[inside]]
+        rock = ~free
+        first = np.argmax(rock, axis=1)
+        found = rock[np.arange(len(ks)), first] & (first > 0)
+        ground = self.origin[2] + (ks[np.arange(len(ks)), first] + 1) * v
+        ok = found & (ground >= p[col_ok, 2] - float(max_drop_m) - 1e-9)
+        res = np.full(len(ks), np.nan)
+        res[ok] = ground[ok]
+        out[col_ok] = res
+        return out
+
+    def start_problem(self, point: np.ndarray) -> str | None:
+        """None if ``point`` is a valid start (inside the grid, in free space), else why not."""
+        p = np.asarray(point, dtype=float).reshape(3)
+        if not self.in_bounds(self.to_index(p))[0]:
+            lo, hi = self.bounds_min, self.bounds_max
+            return ("outside the world (bounds "
+                    f"x∈[{lo[0]:.1f}, {hi[0]:.1f}], y∈[{lo[1]:.1f}, {hi[1]:.1f}], "
+                    f"z∈[{lo[2]:.1f}, {hi[2]:.1f}])")
+        if not self.is_free(p[None])[0]:
+            return "inside rock"
+        return None
+
+    # ------------------------------------------------------------------ io
+    def save_mesh(self, path: str | Path) -> None:
+        """Write the rock mesh to a .ply, .obj or .stl file (binary where the format allows)."""
+        path = Path(path)
+        suffix = path.suffix.lower()
+        if suffix not in MESH_SUFFIXES:
+            raise ValueError(f"cannot save mesh as '{path}': use one of {', '.join(MESH_SUFFIXES)}")
+        mesh = self.mesh
+        if suffix == ".stl" and not mesh.has_triangle_normals():
+            mesh = o3d.geometry.TriangleMesh(mesh)
+            mesh.compute_triangle_normals()
+        elif suffix == ".obj" and mesh.has_triangle_normals():
+            mesh = o3d.geometry.TriangleMesh(mesh)       # OBJ keeps vertex normals only
+            mesh.triangle_normals = o3d.utility.Vector3dVector()
+        path.parent.mkdir(parents=True, exist_ok=True)
+        ok = o3d.io.write_triangle_mesh(str(path), mesh, write_ascii=False,
+                                        write_vertex_normals=suffix != ".stl",
+                                        print_progress=False)
+        if not ok:
+            raise OSError(f"open3d could not write mesh '{path}'")

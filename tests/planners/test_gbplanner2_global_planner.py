@@ -1,0 +1,133 @@
+"""The global planner: global graph, repositioning, homing, goals."""
+import numpy as np
+import pytest
+from delve.planners.gbplanner2 import synthetic as s
+from delve.planners.gbplanner2.config import GBPlannerConfig
+from delve.planners.gbplanner2.global_planner import GlobalPlanner
+from delve.planners.gbplanner2.local_map import LocalMap
+from delve.planners.gbplanner2.local_planner import LocalPlanner, LocalPlanResult, PlanDiagnostics
+from delve.planners.gbplanner2.path_improvement import path_length, segments_admissible
+from delve.planners.occupancy import OCCUPIED, Grid
+
+CFG = GBPlannerConfig.anymal_c(num_vertices_max=200, num_edges_max=3000, low_gain_iterations_max=3)
+
+
+@pytest.fixture(scope="module")
+def tunnel():
+    """A 60 m tunnel mapped to 40 m (open, unknown beyond); home near the west end."""
+    g, a, _b = s.straight_tunnel(length_m=60, mapped_to_m=40)
+    home = a + np.array([2.0, 0, 0.5])
+    return g, a, home
+
+
+def explored(tunnel, positions, seed=0):
+    g, _a, home = tunnel
+    gp = GlobalPlanner(CFG, home)
+    lp = LocalPlanner(CFG)
+    results = []
+    for i, p in enumerate(positions):
+        r = lp.plan(g, p, np.random.default_rng(seed + i))
+        gp.add_local_result(r, g)
+        results.append(r)
+    return gp, results
+
+
+def low_gain_result(root, gain):
+    return LocalPlanResult(path=None, gain=gain, reason="test", diagnostics=PlanDiagnostics(), root=root)
+
+
+def test_frontiers_are_recorded_where_the_gain_is(tunnel):
+    _g, a, _home = tunnel
+    gp, (_r,) = explored(tunnel, [a + np.array([25.0, 0, 0.5])])
+    assert gp.frontiers
+    for f in gp.frontiers.values():
+        assert f.gain >= CFG.frontier_gain_min_m3
+        assert gp.graph.nodes[f.vertex]["kind"] == "frontier"
+    assert gp.graph.number_of_nodes() > 3
+    assert len(gp.frontiers) <= CFG.frontiers_per_iteration_max
+
+
+def test_repositioning_after_k_low_gain_iterations(tunnel):
+    g, a, home = tunnel
+    far = a + np.array([30.0, 0, 0.5])
+    gp, _ = explored(tunnel, [home + np.array([6.0, 0, 0]), far])
+    gp.low_gain_iterations = 0
+    robot = home + np.array([1.0, 0, 0])
+    for k in range(CFG.low_gain_iterations_max):
+        assert not gp.reposition_due
+        gp.add_local_result(low_gain_result(robot, gain=CFG.low_gain_threshold_m3 / 2))
+    assert gp.reposition_due
+    before = dict(gp.frontiers)
+    rep = gp.plan_reposition(g, robot)
+    assert rep.ok, rep.reason
+    assert rep.kind == "reposition" and rep.gain > 0
+    assert np.allclose(rep.path[0], robot)
+    assert np.linalg.norm(rep.path[-1] - rep.target) < 1e-9
+    # the chosen frontier is the best by gain / (path length + offset)
+    chosen = [v for v in before if v not in gp.frontiers]
+    assert len(chosen) == 1
+    assert not gp.reposition_due
+    # a good iteration resets the count
+    gp.add_local_result(low_gain_result(robot, gain=1e6))
+    assert gp.low_gain_iterations == 0
+
+
+def test_reposition_respects_the_endurance(tunnel):
+    g, a, home = tunnel
+    gp, _ = explored(tunnel, [a + np.array([30.0, 0, 0.5])])
+    rep = gp.plan_reposition(g, home, endurance_remaining_s=5.0)
+    assert not rep.ok and "endurance" in rep.reason
+
+
+def test_homing_triggers_only_when_endurance_is_short(tunnel):
+    g, a, home = tunnel
+    p = a + np.array([30.0, 0, 0.5])
+    gp, _ = explored(tunnel, [home + np.array([8.0, 0, 0]), a + np.array([20.0, 0, 0.5]), p])
+    way = gp.plan_home(g, p)
+    assert way.ok, way.reason
+    assert np.allclose(way.path[-1], home) and np.allclose(way.path[0], p)
+    assert path_length(way.path) >= np.linalg.norm(p - home) - 1e-6
+    long = gp.homing_check(g, p, endurance_remaining_s=3600.0)
+    assert not long.required
+    t_home = way.length_m / CFG.speed_mps
+    short = gp.homing_check(g, p, endurance_remaining_s=t_home + CFG.homing_margin_s)
+    assert short.required
+    assert short.time_home_s == pytest.approx(t_home)
+    lm = LocalMap(g, way.path.min(axis=0) - 1, way.path.max(axis=0) + 1, CFG)
+    assert segments_admissible(lm, way.path).all()
+
+
+def test_path_to_a_goal_point_and_blocked_edges(tunnel):
+    g, a, _home = tunnel
+    p = a + np.array([4.0, 0, 0.5])
+    gp, _ = explored(tunnel, [p, a + np.array([16.0, 0, 0.5])])
+    goal = a + np.array([22.0, 0.5, 0.5])
+    res = gp.plan_to_goal(g, p, goal)
+    assert res.ok, res.reason
+    assert np.allclose(res.path[0], p) and np.allclose(res.path[-1], goal)
+    near = gp.plan_to_goal(g, p, p + np.array([2.0, 0, 0]))
+    assert near.ok and len(near.path) == 2
+    # rock across the tunnel, mapped after the graph was built: no way through
+    occ = g.occupancy.copy()
+    i = g.to_index((a + np.array([12.0, 0, 0]))[None])[0]
+    occ[i[0]:i[0] + 2, :, :] = OCCUPIED
+    blocked = Grid(occ, g.origin, g.voxel_size_m)
+    res2 = gp.plan_to_goal(blocked, p, goal)
+    assert not res2.ok and res2.reason
+    outside = gp.plan_to_goal(g, p, np.array([1e4, 0, 0]))
+    assert not outside.ok and "outside" in outside.reason
+
+
+def test_frontiers_are_dropped_once_explored(tunnel):
+    _g, a, home = tunnel
+    gp, _ = explored(tunnel, [a + np.array([30.0, 0, 0.5])])
+    assert gp.frontiers
+    mapped, _, _ = s.straight_tunnel(length_m=60)
+    gp.update_frontiers(mapped)
+    assert not gp.frontiers
+    assert not gp.plan_reposition(mapped, home).ok
+
+
+def test_invalid_home_raises():
+    with pytest.raises(ValueError):
+        GlobalPlanner(CFG, np.array([np.nan, 0, 0]))

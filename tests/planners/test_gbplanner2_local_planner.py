@@ -1,0 +1,111 @@
+"""The local planner (Algorithm 1) end to end on small synthetic worlds."""
+import numpy as np
+import pytest
+from delve.planners.gbplanner2 import synthetic as s
+from delve.planners.gbplanner2.config import GBPlannerConfig
+from delve.planners.gbplanner2.local_map import LocalMap
+from delve.planners.gbplanner2.local_planner import LocalPlanner
+from delve.planners.gbplanner2.path_improvement import path_length, segments_admissible
+from delve.planners.occupancy import OCCUPIED, UNKNOWN, Grid
+
+LEGGED = GBPlannerConfig.anymal_c(num_vertices_max=250, num_edges_max=4000)
+AERIAL = GBPlannerConfig.rmf_obelix(num_vertices_max=250)
+
+
+def check_path(grid, cfg, path):
+    lm = LocalMap(grid, path.min(axis=0) - 1, path.max(axis=0) + 1, cfg, clear_box_at=path[0])
+    assert segments_admissible(lm, path).all()
+
+
+@pytest.mark.parametrize("cfg,up,vs", [(LEGGED, 0.5, 0.2), (AERIAL, 1.5, 0.3)])
+def test_path_heads_for_the_unknown_end_of_the_tunnel(cfg, up, vs):
+    g, a, b = s.straight_tunnel(length_m=40, mapped_to_m=26, yaw_deg=30, voxel_size_m=vs)
+    u = (b - a) / np.linalg.norm(b - a)
+    p = a + 10 * u + np.array([0, 0, up])
+    res = LocalPlanner(cfg).plan(g, p, np.random.default_rng(0))
+    assert res.ok, res.reason
+    assert res.gain > 0
+    assert (res.path[-1] - res.path[0]) @ u > 5.0
+    assert path_length(res.path) <= cfg.traverse_length_max_m + 1e-6
+    check_path(g, cfg, res.path)
+    d = res.diagnostics
+    assert d.num_vertices == res.graph.num_vertices > 100
+    assert d.total_s >= d.graph_s + d.gain_s + d.shortest_paths_s
+    assert res.direction_rad is not None
+
+
+def test_same_inputs_and_seed_give_the_same_result():
+    g, a, _b = s.straight_tunnel(length_m=30, mapped_to_m=20)
+    p = a + np.array([8.0, 0, 0.5])
+    lp = LocalPlanner(LEGGED)
+    r1 = lp.plan(g, p, np.random.default_rng(42))
+    r2 = lp.plan(g, p, np.random.default_rng(42))
+    assert np.array_equal(r1.path, r2.path) and r1.gain == r2.gain
+    assert np.array_equal(r1.graph.vertices, r2.graph.vertices)
+
+
+def test_legged_paths_never_end_at_or_cross_hanging_vertices():
+    g, west, hole = s.shaft_tunnel()
+    p = np.array([hole.lo[0] - 2.5, west[1], west[2] + 0.5])
+    cfg = LEGGED.replace(num_vertices_max=300)
+    for seed in range(3):
+        res = LocalPlanner(cfg).plan(g, p, np.random.default_rng(seed))
+        graph = res.graph
+        assert graph.hanging.any()
+        if res.ok:
+            assert not graph.hanging[res.vertex_path].any()
+            # never over the shaft (the ground circle reaches a little past its rim)
+            assert np.all(res.path[:, 0] < hole.lo[0] + cfg.ground_circle_radius_m + 0.05)
+            check_path(g, cfg, res.path)
+
+
+def test_unplannable_situations_return_a_reason_instead_of_raising():
+    g, a, _b = s.straight_tunnel(length_m=20)
+    lp = LocalPlanner(LEGGED)
+    rng = np.random.default_rng(0)
+    outside = lp.plan(g, np.array([-50.0, 0, 0]), rng)
+    assert outside.path is None and "outside" in outside.reason
+    in_rock = lp.plan(g, a + np.array([5.0, 0, -0.1]), rng)
+    assert in_rock.path is None and "start position is invalid" in in_rock.reason
+    nan = lp.plan(g, np.array([np.nan, 0, 0]), rng)
+    assert nan.path is None and nan.reason
+    empty = Grid(np.full((50, 50, 20), UNKNOWN, np.int8), np.zeros(3), 0.2)
+    r = lp.plan(empty, np.array([5.0, 5.0, 2.0]), rng)
+    assert r.path is None and r.reason
+    closed = np.full((40, 40, 20), OCCUPIED, np.int8)
+    closed[18:23, 18:23, 8:13] = 0
+    r = LocalPlanner(AERIAL).plan(Grid(closed, np.zeros(3), 0.2), np.array([4.1, 4.1, 2.1]), rng)
+    assert r.path is None and r.reason
+
+
+def test_fully_explored_tunnel_gives_no_gain_path():
+    g, a, _b = s.straight_tunnel(length_m=24)
+    res = LocalPlanner(LEGGED).plan(g, a + np.array([8.0, 0, 0.5]), np.random.default_rng(0))
+    assert res.path is None and "gain" in res.reason
+    assert res.graph is not None and res.graph.num_vertices > 1
+
+
+def test_exploration_bounds_keep_vertices_inside():
+    g, a, _b = s.straight_tunnel(length_m=30, mapped_to_m=20)
+    p = a + np.array([8.0, 0, 0.5])
+    lo, hi = a + np.array([4.0, -5, -5]), a + np.array([12.0, 5, 5])
+    res = LocalPlanner(LEGGED).plan(g, p, np.random.default_rng(0), exploration_bounds=(lo, hi))
+    v = res.graph.vertices[1:]
+    assert np.all((v >= lo) & (v <= hi))
+
+
+def test_unseen_ground_right_under_a_legged_robot_counts_as_ground():
+    # A LiDAR on the body cannot see the floor within a couple of metres of the robot.
+    g, a, _b = s.straight_tunnel(length_m=30, mapped_to_m=24)
+    p = a + np.array([8.0, 0, 0.5])
+    occ = g.occupancy.copy()
+    lo = g.to_index((p - np.array([1.8, 1.8, 0.7]))[None])[0]
+    hi = g.to_index((p + np.array([1.8, 1.8, -0.45]))[None])[0]
+    floor = occ[lo[0]:hi[0], lo[1]:hi[1], lo[2]:hi[2] + 1]
+    floor[floor == OCCUPIED] = UNKNOWN
+    blind = Grid(occ, g.origin, g.voxel_size_m)
+    assert blind.value_at((p - np.array([0, 0, 0.6]))[None])[0] == UNKNOWN
+    ok = LocalPlanner(LEGGED).plan(blind, p, np.random.default_rng(0))
+    assert ok.ok, ok.reason
+    strict = LocalPlanner(LEGGED.replace(assumed_ground_radius_m=0.0)).plan(blind, p, np.random.default_rng(0))
+    assert not strict.ok

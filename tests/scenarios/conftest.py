@@ -1,0 +1,23 @@
+"""Shared helpers for scenario tests: run a scenario file to the end."""
+from pathlib import Path
+
+import pytest
+
+from delve.executive.outputs import write_outputs
+from delve.executive.runner import Mission
+from delve.executive.scenario import load_scenario
+
+DATA = Path(__file__).parent / "data"
+
+
+def run_scenario(path: Path, out: Path | None = None, **kw) -> tuple[Mission, dict]:
+    """Run a scenario; write its outputs into ``out`` when given. Returns the mission and report."""
+    mission = Mission(load_scenario(path), **kw)
+    mission.run()
+    report = write_outputs(mission, out, 1.0) if out is not None else None
+    return mission, report
+
+
+@pytest.fixture(scope="session")
+def data_dir() -> Path:
+    return DATA
