@@ -4,7 +4,8 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test setup system-deps bench clean
+.PHONY: demo test setup system-deps bench docs clean
+
 
 demo: setup
 	$(BIN)/delve demo
@@ -36,6 +37,11 @@ $(STAMP): $(VENV)/bin/python pyproject.toml
 bench: setup
 	$(BIN)/python bench/sim_speed.py
 	$(BIN)/python bench/bt_overhead.py
+	$(BIN)/python bench/gbplanner.py
+
+# Regenerate the tree JSON Schema and docs/nodes.md from the node registry.
+docs: setup
+	$(BIN)/python -m delve.executive.registry --write-schema --write-docs
 
 clean:
 	rm -rf $(VENV) delve-out .pytest_cache
