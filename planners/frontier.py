@@ -20,6 +20,8 @@ from .occupancy import FREE, UNKNOWN, Grid
 
 
 
+
+
 @dataclass(frozen=True)
 class FrontierCluster:
     """A connected set of frontier voxels: their flat indices and world centroid."""
@@ -35,7 +37,7 @@ class FrontierCluster:
 @dataclass(frozen=True)
 class FrontierGoal:
     """The chosen cluster, the graph node to go to, the path length to it and the
-    straight distance from that node to the nearest sampled voxel of the cluster."""
+    straight distance from that node to the cluster's centroid."""
 
     cluster: FrontierCluster
     node: int
@@ -53,17 +55,15 @@ def frontier_voxels(grid: Grid, among: np.ndarray | None = None, depth: int = 3)
     otherwise observed space.
     """
     flat_occ = grid.occupancy.reshape(-1)
-    flat = grid.free_voxels() if among is None else among[flat_occ[among] == FREE]
-
-    free = Voxels(flat, grid.shape)
+    free = Voxels.free_of(grid) if among is None else Voxels(among[flat_occ[among] == FREE], grid.shape)
     is_frontier = np.zeros(len(free), dtype=bool)
     for d in FACES:
         solid = free.at(flat_occ, d, FREE) == UNKNOWN
         for k in range(2, depth + 1):
             idx = np.flatnonzero(solid)
-            solid[idx] = free.subset(idx).at(flat_occ, (d[0] * k, d[1] * k, d[2] * k), FREE) == UNKNOWN
+            solid[idx] = free.at(flat_occ, (d[0] * k, d[1] * k, d[2] * k), FREE, idx) == UNKNOWN
         is_frontier |= solid
-    return flat[is_frontier]
+    return free.flat[is_frontier]
 
 
 def frontier_clusters(grid: Grid, voxels: np.ndarray, *, cluster_radius_m: float, min_cluster_voxels: int,
@@ -107,36 +107,39 @@ def nearest_frontier(
     graph: NavGraph,
     distances: np.ndarray,
     clusters: list[FrontierCluster],
-    grid: Grid,
     *,
     max_goal_offset_m: float,
+    view_up_deg: float = 90.0,
+    sensor_height_m: float = 0.0,
     offset_weight: float = 2.0,
-    samples_per_cluster: int = 16,
+    node_spacing_m: float = 0.6,
 ) -> FrontierGoal | None:
+    """The cluster whose goal node is cheapest: path length from the robot
+    (``distances``) plus ``offset_weight`` times the straight distance to the cluster.
 
-    """The cluster whose goal node is nearest along the graph (``distances`` from the robot).
-
-    A cluster's goal is the reachable node that minimises path length plus
-    ``offset_weight`` times its straight distance to the cluster, within
-    ``max_goal_offset_m`` of it (a far goal approaches a frontier the map cannot reach
-    yet; a weight above 1 makes the node nearest the frontier win over the robot's
-    own). Clusters without such a node are skipped; the cheapest cluster is chosen.
+    A goal node must lie within ``max_goal_offset_m`` of the cluster's centroid and
+    see it: the centroid may be at most ``view_up_deg`` above the sensor
+    (``sensor_height_m`` above the node), so a ceiling frontier is approached from
+    where a LiDAR with a narrow vertical field of view can see it, not from below. A
+    far goal approaches a frontier the map cannot reach yet; a weight above 1 makes
+    the node nearest the frontier win over the robot's own. Candidate nodes are
+    thinned to one per ``node_spacing_m`` cell. None when no cluster has a goal.
     """
     reachable = np.flatnonzero(np.isfinite(distances))
     if len(reachable) == 0 or not clusters:
         return None
-    # Up to ``samples_per_cluster`` voxels of each cluster, evenly spread, stand for it.
-    picks = [c.voxels[:: max(1, c.size // samples_per_cluster)] for c in clusters]
-    voxels = np.concatenate(picks)
-    owner = np.repeat(np.arange(len(clusters)), [len(p) for p in picks])
-    pts = grid.to_world(np.stack(np.unravel_index(voxels, grid.shape), axis=1))
-    d, i = cKDTree(graph.positions[reachable]).query(pts, distance_upper_bound=max_goal_offset_m)
-    ok = np.isfinite(d)
-    if not ok.any():
+    cell = np.floor(graph.positions[reachable] / node_spacing_m).astype(np.int64)
+    _, first = np.unique(cell, axis=0, return_index=True)
+    nodes = reachable[np.sort(first)]
+    centroids = np.array([c.centroid for c in clusters])
+    diff = centroids[:, None, :] - graph.positions[nodes][None, :, :]
+    offset = np.linalg.norm(diff, axis=2)
+    rise = diff[:, :, 2] - sensor_height_m
+    level = np.hypot(diff[:, :, 0], diff[:, :, 1])
+    seen = rise <= level * np.tan(np.radians(min(view_up_deg, 89.9))) + 0.5 * node_spacing_m
+    cost = np.where((offset <= max_goal_offset_m) & seen, distances[nodes][None, :] + offset_weight * offset, np.inf)
+    c, n = np.unravel_index(int(np.argmin(cost)), cost.shape)
+    if not np.isfinite(cost[c, n]):
         return None
-    nodes = reachable[i[ok]]
-    cost = distances[nodes] + offset_weight * d[ok]
-    k = int(np.argmin(cost))
-    return FrontierGoal(cluster=clusters[owner[ok][k]], node=int(nodes[k]), path_length_m=float(distances[nodes[k]]),
-                        offset_m=float(d[ok][k]))
-
+    node = int(nodes[n])
+    return FrontierGoal(cluster=clusters[c], node=node, path_length_m=float(distances[node]), offset_m=float(offset[c, n]))

@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .platforms import Platform
+from .radio import BREADCRUMB_ANTENNA_HEIGHT_M, BreadcrumbDrop
 from .voxel_map import VoxelMap
 
 if TYPE_CHECKING:
@@ -92,7 +93,13 @@ class SimRobot:
         return self._yaw
 
     @property
+    def view_up_deg(self) -> float:
+        lidar = self._platform.lidar
+        return lidar.pitch_deg + lidar.vertical_fov_deg / 2
+
+    @property
     def home(self) -> np.ndarray:
+
         return self._home.copy()
 
     @property
@@ -118,6 +125,26 @@ class SimRobot:
     @property
     def path_status(self) -> str:
         return self._status
+
+    @property
+    def breadcrumbs(self) -> int:
+        """Breadcrumbs (mesh relay nodes) the robot still carries."""
+        return self._radio.breadcrumbs
+
+    def deploy_breadcrumb(self) -> BreadcrumbDrop:
+        """Drop a breadcrumb on the ground under the robot, its antenna
+        ``BREADCRUMB_ANTENNA_HEIGHT_M`` up. A refusal (none left, no ground) is a
+        result with ``ok=False`` and an ``error``, never an exception."""
+        if self._platform.aerial:
+            drop = float(self._pos[2] - self.world.origin[2])
+            ground = float(self.world.ground_height(self._pos[None], drop)[0])
+        else:
+            ground = self._ground
+        if math.isnan(ground):
+            return BreadcrumbDrop(False, self._name, None, self.breadcrumbs,
+                                  f"{self._name} has no ground below to drop a breadcrumb on")
+        spot = np.array([self._pos[0], self._pos[1], ground + BREADCRUMB_ANTENNA_HEIGHT_M])
+        return self._radio.deploy_breadcrumb(spot)
 
     @property
     def alive(self) -> bool:

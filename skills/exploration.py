@@ -109,8 +109,9 @@ float, 2.0, "how often the target cluster is re-checked", exclusive_minimum=0),
                                      max_extent_m=self.p["max_cluster_extent_m"])
         self.bb.set(self.k_left, len(clusters))
         while True:
-            goal = nearest_frontier(plan.graph, plan.distances, clusters, grid,
-                                    max_goal_offset_m=self.p["max_goal_offset_m"])
+            goal = nearest_frontier(plan.graph, plan.distances, clusters, max_goal_offset_m=self.p["max_goal_offset_m"],
+                                    view_up_deg=self.robot.view_up_deg)
+
             if goal is None:
                 self.feedback_message = "no reachable frontier left"
                 self.event("exploration_complete", blacklisted_voxels=len(self.blacklist))

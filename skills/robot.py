@@ -89,6 +89,20 @@ class Radio(Protocol):
     def pending(self) -> int:
         """Messages still waiting in the outbox."""
 
+    def ping(self, other: str) -> bool:
+        """One echo request to ``other`` and its reply; False when either is lost or
+        no route exists. Each call is one attempt (it may fail on a working link)."""
+
+
+class BreadcrumbDrop(Protocol):
+    """The result of a breadcrumb drop: ``ok`` and the new relay's ``name``, or an
+    ``error`` saying why not (no breadcrumbs left, ...); ``remaining`` after it."""
+
+    ok: bool
+    name: str | None
+    remaining: int
+    error: str
+
 
 class Robot(Protocol):
     """A robot as skills see it."""
@@ -111,7 +125,13 @@ class Robot(Protocol):
     def yaw_rad(self) -> float: ...
 
     @property
+    def view_up_deg(self) -> float:
+        """How far above the horizontal the main range sensor sees (half a LiDAR's
+        vertical field of view), so planners pick viewpoints it can see from."""
+
+    @property
     def home(self) -> np.ndarray:
+
         """(3,) position the robot started from (the base station's side)."""
 
     @property
@@ -138,3 +158,10 @@ class Robot(Protocol):
 
     @property
     def path_status(self) -> PathStatus: ...
+
+    @property
+    def breadcrumbs(self) -> int:
+        """Breadcrumbs (mesh relay nodes) the robot still carries."""
+
+    def deploy_breadcrumb(self) -> BreadcrumbDrop:
+        """Drop a breadcrumb where the robot stands; a refusal is a result, not an exception."""

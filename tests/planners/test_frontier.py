@@ -33,7 +33,7 @@ def test_clusters_and_nearest_choice():
     g = legged_graph(grid, body_height_m=0.5, radius_m=0.4, max_step_m=0.3, max_inclination_deg=35)
     src = g.nearest(np.array([3.5, 5.5, 0.9]), 1.0)
     dist, _ = g.shortest_paths(src)
-    goal = nearest_frontier(g, dist, clusters, grid, max_goal_offset_m=3.0)
+    goal = nearest_frontier(g, dist, clusters, max_goal_offset_m=3.0)
     assert goal is not None
     # the side branch (y ~ 9 m) is nearer to x=3.5 than the corridor's end at x=8
     assert goal.cluster.centroid[1] > 8.0
