@@ -129,17 +129,25 @@ def nearest_frontier(
     if len(reachable) == 0 or not clusters:
         return None
     cell = np.floor(graph.positions[reachable] / node_spacing_m).astype(np.int64)
-    _, first = np.unique(cell, axis=0, return_index=True)
+    cell -= cell.min(axis=0)
+    span = cell.max(axis=0) + 1
+    _, first = np.unique((cell[:, 0] * span[1] + cell[:, 1]) * span[2] + cell[:, 2], return_index=True)
     nodes = reachable[np.sort(first)]
     centroids = np.array([c.centroid for c in clusters])
-    diff = centroids[:, None, :] - graph.positions[nodes][None, :, :]
-    offset = np.linalg.norm(diff, axis=2)
-    rise = diff[:, :, 2] - sensor_height_m
-    level = np.hypot(diff[:, :, 0], diff[:, :, 1])
-    seen = rise <= level * np.tan(np.radians(min(view_up_deg, 89.9))) + 0.5 * node_spacing_m
-    cost = np.where((offset <= max_goal_offset_m) & seen, distances[nodes][None, :] + offset_weight * offset, np.inf)
-    c, n = np.unravel_index(int(np.argmin(cost)), cost.shape)
-    if not np.isfinite(cost[c, n]):
+    near = cKDTree(graph.positions[nodes]).query_ball_point(centroids, max_goal_offset_m)
+    owner = np.repeat(np.arange(len(clusters)), [len(n) for n in near])
+    if len(owner) == 0:
         return None
-    node = int(nodes[n])
-    return FrontierGoal(cluster=clusters[c], node=node, path_length_m=float(distances[node]), offset_m=float(offset[c, n]))
+    cand = nodes[np.concatenate([np.asarray(n, dtype=np.int64) for n in near])]
+    diff = centroids[owner] - graph.positions[cand]
+    offset = np.linalg.norm(diff, axis=1)
+    level = np.hypot(diff[:, 0], diff[:, 1])
+    seen = diff[:, 2] - sensor_height_m <= level * np.tan(np.radians(min(view_up_deg, 89.9))) + 0.5 * node_spacing_m
+    cost = np.where(seen, distances[cand] + offset_weight * offset, np.inf)
+    k = int(np.argmin(cost))
+    if not np.isfinite(cost[k]):
+        return None
+    node = int(cand[k])
+    return FrontierGoal(cluster=clusters[owner[k]], node=node, path_length_m=float(distances[node]),
+                        offset_m=float(offset[k]))
+

@@ -2,7 +2,7 @@
 
 The :class:`Navigator` keeps the navigation graph of the robot's onboard map and the
 shortest-path tree from the robot, and rebuilds them when the map has changed and
-they are older than ``rebuild_period_s`` of sim time, so that several skills ticking
+they are older than ``rebuild_period_s`` (10 s) of sim time, so that several skills ticking
 in one agent do not plan twice.
 """
 from __future__ import annotations
@@ -35,8 +35,7 @@ class Navigator:
 
     snap_radii_m = (1.0, 2.0)
 
-    def __init__(self, robot: Robot, ctx: AgentContext, rebuild_period_s: float = 5.0):
-
+    def __init__(self, robot: Robot, ctx: AgentContext, rebuild_period_s: float = 10.0):
         self.robot = robot
         self.ctx = ctx
         self.rebuild_period_s = rebuild_period_s
@@ -83,9 +82,14 @@ class Navigator:
         return None
 
     def from_robot(self, force: bool = False) -> Plan | None:
-        """Shortest paths from the robot's position; None when it is off the graph."""
+        """Shortest paths from the robot's position; None when it is off the graph
+        (after rebuilding the graph once, in case the robot walked off an old one)."""
         graph = self.graph(force)
         source = self.node_near(graph, self.robot.position)
+        if source is None and not force:
+            graph = self.graph(force=True)
+            source = self.node_near(graph, self.robot.position)
+
         if source is None:
             return None
         key = (id(graph), source)
