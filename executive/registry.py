@@ -662,7 +662,7 @@ BEHAVIOURS = [
         behaviours.CheckBlackboardVariableValue,
         {
             "variable_name": Param(str, REQUIRED, doc=_KEY, key=True),
-            "value": AnyParam(default=REQUIRED, doc="value to compare the variable with"),
+            "value": AnyParam(default=REQUIRED, nullable=True, doc="value to compare the variable with (null: unset)"),
             "operator": _OPERATOR,
         },
         "SUCCESS if 'variable OPERATOR value' holds, FAILURE if not or if the variable is missing.",
@@ -672,7 +672,7 @@ BEHAVIOURS = [
         behaviours.WaitForBlackboardVariableValue,
         {
             "variable_name": Param(str, REQUIRED, doc=_KEY, key=True),
-            "value": AnyParam(default=REQUIRED, doc="value to compare the variable with"),
+            "value": AnyParam(default=REQUIRED, nullable=True, doc="value to compare the variable with (null: unset)"),
             "operator": _OPERATOR,
         },
         "RUNNING until 'variable OPERATOR value' holds, then SUCCESS.",

@@ -3,7 +3,8 @@ simulation until every robot's tree has finished or the scenario's time is up.""
 from __future__ import annotations
 
 import math
-import time
+from collections import deque
+
 from dataclasses import dataclass, field, replace
 from typing import Any, Callable
 
@@ -18,6 +19,7 @@ from ..sim.robot import SimRobot
 from ..sim.voxel_map import VoxelMap
 from ..sim.world import World
 from ..skills.base import AgentContext
+from ..skills.operator import COMMAND
 from .agent import Agent
 from .errors import DelveError
 from .scenario import RobotSpec, Scenario
@@ -75,7 +77,8 @@ class Mission:
                               else self.world.start + np.array([0.0, 0.0, 1.0]), dtype=float)
         self.base_position = base_pos
         self.base_map = VoxelMap(self.world.free.shape, self.world.origin, self.world.voxel_size_m)
-        base_radio = self.radio.add(BASE, lambda: base_pos)
+        base_radio = self.radio.add(BASE, lambda: base_pos, breadcrumbs=0)
+
         for spec in scenario.robots:
             robot = self.robots[spec.name]
             ctx = self._context(spec.name, robot)
@@ -86,6 +89,8 @@ class Mission:
             ctx.services.update(radio=base_radio, map=self.base_map)
             self.agents[BASE] = Agent(BASE, load_tree(scenario.base_tree, ctx), 1.0 / scenario.base_tick_hz, ctx,
                                       on_change=self._status_changed)
+        self._commands = deque(scenario.supervisor)
+        self._faults = deque(scenario.faults)
         reach = self.world.reachable_free(self._first_start())
         self.truth = np.flatnonzero(reach.reshape(-1))
         self.finished_s: float | None = None
@@ -100,7 +105,7 @@ class Mission:
         platform = replace(base, **spec.overrides, lidar=replace(base.lidar, **spec.lidar))
         start = np.asarray(spec.start, float) if spec.start is not None else self._free_start(index)
         holder: dict[str, SimRobot] = {}
-        radio = self.radio.add(spec.name, lambda: holder["r"].position)
+        radio = self.radio.add(spec.name, lambda: holder["r"].position, breadcrumbs=spec.breadcrumbs)
         robot = SimRobot(spec.name, platform, self.world, start, radio, spec.endurance_s)
         holder["r"] = robot
         return robot
@@ -136,6 +141,7 @@ class Mission:
         self.log("mission_start", scenario=self.scenario.name, seed=self.seed)
         while True:
             now = self.clock.now_s
+            self._supervise(now)
             self._sense(now)
             self.radio.update()
             for agent in self.agents.values():
@@ -163,6 +169,21 @@ class Mission:
         self._sample(self.clock.now_s)
         if progress is not None:
             progress(self)
+
+    def _supervise(self, now: float) -> None:
+        """Send the supervisor's commands that are due, and inject due faults."""
+        while self._commands and self._commands[0].at_s <= now + 1e-9:
+            c = self._commands.popleft()
+            self.radio.endpoints[BASE].send(c.robot, COMMAND, {"command": c.command, "args": c.args})
+            self.log("supervisor_command", robot=c.robot, command=c.command, **c.args)
+        while self._faults and self._faults[0].at_s <= now + 1e-9:
+            f = self._faults.popleft()
+            robot = self.robots[f.robot]
+            if f.kind == "stuck":
+                robot.jam(f.duration_s)
+            else:
+                robot.inject_map_artifact()
+            self.log("fault", robot=f.robot, kind=f.kind, duration_s=f.duration_s)
 
     def _sense(self, now: float) -> None:
         for name, robot in self.robots.items():

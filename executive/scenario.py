@@ -17,6 +17,8 @@ import jsonschema
 from ..sim import worldgen
 from ..sim.world import World
 from .errors import DelveError, did_you_mean
+from .supervisor import Command, load_supervisor
+
 from .yamlio import YamlDict, YamlList, load_yaml, plain
 
 SCHEMA_PATH = Path(__file__).parent / "schema" / "scenario.schema.json"
@@ -42,8 +44,21 @@ class RobotSpec:
     tick_hz: float = 5.0
     overrides: dict[str, float] = field(default_factory=dict)
     lidar: dict[str, float] = field(default_factory=dict)
+    breadcrumbs: int = 0
     line: int | None = None
     start_line: int | None = None
+
+
+@dataclass(frozen=True)
+class Fault:
+    """A fault injected at ``at_s``: ``stuck`` (the robot cannot move for
+    ``duration_s``) or ``map_artifact`` (rock appears in its onboard map around it,
+    as odometry drift leaves in a real map)."""
+
+    at_s: float
+    robot: str
+    kind: str
+    duration_s: float = 0.0
 
 
 @dataclass
@@ -63,6 +78,8 @@ class Scenario:
     base_tick_hz: float
     radio: dict[str, float]
     doc: YamlDict
+    supervisor: list[Command] = field(default_factory=list)
+    faults: list[Fault] = field(default_factory=list)
 
     def build_world(self, seed: int | None = None) -> World:
         """Generate or load the world (a DelveError when its parameters are wrong).
@@ -159,7 +176,7 @@ def load_scenario(path: str | Path) -> Scenario:
     _world_params(doc["world"], path)
     from .tree_loader import check_tree
 
-    robots, names = [], set()
+    robots, names = [], set()  # names: the robots seen so far
     for i, r in enumerate(doc["robots"]):
         line = doc["robots"].item_line(i)
         if r["name"] in names or r["name"] == "base":
@@ -173,8 +190,8 @@ def load_scenario(path: str | Path) -> Scenario:
         extra = {k: float(r[k]) for k in ("speed_mps", "max_inclination_deg", "max_step_m") if k in r}
         robots.append(RobotSpec(name=r["name"], platform=r["platform"], tree=tree, start=r.get("start"),
                                 endurance_s=r.get("endurance_s"), tick_hz=float(r.get("tick_hz", 5.0)),
-                                overrides=extra, lidar=plain(r.get("lidar", {})), line=line,
-                                start_line=r.key_line("start")))
+                                overrides=extra, lidar=plain(r.get("lidar", {})), breadcrumbs=r.get("breadcrumbs", 0),
+                                line=line, start_line=r.key_line("start")))
 
     base = doc.get("base_station", {})
     base_tree = None
@@ -183,9 +200,19 @@ def load_scenario(path: str | Path) -> Scenario:
         if not base_tree.exists():
             raise DelveError(f"base station tree file not found: {base['tree']}", path, base.key_line("tree"))
         check_tree(base_tree)
+    supervisor = load_supervisor(doc.get("supervisor"), path, {r.name: r.breadcrumbs for r in robots})
+    faults = []
+    for i, f in enumerate(doc.get("faults", [])):
+        if f["robot"] not in names:
+            raise DelveError(f"fault for unknown robot {f['robot']!r}{did_you_mean(f['robot'], names)}", path,
+                             doc["faults"].item_line(i))
+        if f["kind"] == "stuck" and "duration_s" not in f:
+            raise DelveError("a 'stuck' fault needs duration_s", path, doc["faults"].item_line(i))
+        faults.append(Fault(float(f["at_s"]), f["robot"], f["kind"], float(f.get("duration_s", 0.0))))
     values = {k: doc.get(k, v) for k, v in DEFAULTS.items()}
     return Scenario(path=path, name=doc["name"], seed=int(values["seed"]), duration_s=float(values["duration_s"]),
                     dt_s=float(values["dt_s"]), coverage_period_s=float(values["coverage_period_s"]),
                     world=plain(doc["world"]), robots=robots, base_tree=base_tree,
                     base_position=base.get("position"), base_tick_hz=float(base.get("tick_hz", 1.0)),
-                    radio=plain(doc.get("radio", {})), doc=doc)
+                    radio=plain(doc.get("radio", {})), doc=doc, supervisor=supervisor,
+                    faults=sorted(faults, key=lambda f: f.at_s))

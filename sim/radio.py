@@ -27,7 +27,7 @@ The link model (one evaluation per pair of nodes, every ``update_period_s``):
 
 Defaults (:class:`RadioSpec`) stand for the 5.8 GHz Rajant mesh radios of the CERBERUS
 paper (section 3.4) carried low on robots in rough tunnels: 20 dBm EIRP, free-space
-loss 47.7 dB at 1 m for 5.8 GHz, path-loss exponent 2.6 and an 82 dBm sensitivity.
+loss 47.7 dB at 1 m for 5.8 GHz, path-loss exponent 2.6 and a −82 dBm sensitivity.
 A straight tunnel links at up to ~122 m (quality ≈ 0.5 at 100 m, 0.86 at 50 m), a
 right-angle corner of a 4 m tunnel cuts that to some 20 m of total separation
 (10 m either side of the corner), and 10 m of rock or more between two tunnels
@@ -52,10 +52,12 @@ route), so a run is reproducible from its seed.
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections import deque
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Callable
+from typing import TYPE_CHECKING, Any
 
 import networkx as nx
 import numpy as np
@@ -196,7 +198,7 @@ class LinkState:
         return self.budget.loss
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Breadcrumb:
     """A deployed static relay node."""
 
@@ -228,7 +230,7 @@ class BreadcrumbDrop:
 class RadioEndpoint:
     """One node's radio (implements the robot interface's ``Radio``)."""
 
-    def __init__(self, name: str, network: "RadioNetwork", breadcrumbs: int = 0, relay: bool = True):
+    def __init__(self, name: str, network: RadioNetwork, breadcrumbs: int = 0, relay: bool = True):
         self.name = name
         self._net = network
         self.outbox: deque[Message] = deque()
@@ -274,7 +276,7 @@ class RadioNetwork:
     joins ``a`` and ``b`` through the mesh, ``direct_link(a, b)`` when one link does.
     """
 
-    def __init__(self, spec: RadioSpec, world: "World", rng: np.random.Generator, now_s: Callable[[], float]):
+    def __init__(self, spec: RadioSpec, world: World, rng: np.random.Generator, now_s: Callable[[], float]):
         self.spec = spec
         self.world = world
         self.rng = rng
@@ -456,7 +458,7 @@ class RadioNetwork:
 
     def _hops_survive(self, path: list[str]) -> bool:
         """Draw each hop of ``path`` in order; False at the first lost hop."""
-        for u, v in zip(path, path[1:]):
+        for u, v in itertools.pairwise(path):
             if self.rng.random() < self._links[(min(u, v), max(u, v))].loss:
                 return False
         return True

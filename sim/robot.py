@@ -12,7 +12,8 @@ import numpy as np
 
 from .platforms import Platform
 from .radio import BREADCRUMB_ANTENNA_HEIGHT_M, BreadcrumbDrop
-from .voxel_map import VoxelMap
+from .voxel_map import OCCUPIED, UNKNOWN, VoxelMap
+
 
 if TYPE_CHECKING:
     from .radio import RadioEndpoint
@@ -67,6 +68,7 @@ class SimRobot:
         self._status = IDLE
         self.blocked_reason = ""
         self._scans = 0
+        self._stuck_s = 0.0
         self._parked = False
 
         self._sensors = [(spec, spec.beam_directions(0.0)) for spec in (platform.lidar, platform.terrain) if spec]
@@ -150,6 +152,21 @@ class SimRobot:
     def alive(self) -> bool:
         return self._endurance > 0
 
+    def jam(self, duration_s: float) -> None:
+        """A fault: the feet (or rotors) are stuck for ``duration_s``; a path being
+        followed stays FOLLOWING but the robot does not move."""
+        self._stuck_s = max(self._stuck_s, duration_s)
+
+    def inject_map_artifact(self, radius_m: float = 1.5) -> None:
+        """A fault: rock appears in the onboard map all around the robot, as odometry
+        drift leaves in a real map, so planners find its start pose invalid."""
+        self._map.set_sphere(self._pos, radius_m, OCCUPIED)
+
+    def reset_local_map(self, radius_m: float) -> None:
+        """Forget the onboard map within ``radius_m`` of the robot (the next scans
+        map it again), as the paper's behaviour tree resets the elevation map."""
+        self._map.set_sphere(self._pos, radius_m, UNKNOWN)
+
     def park(self) -> None:
         """Stop and power down: endurance no longer counts down (the mission is over)."""
         self.stop()
@@ -179,6 +196,9 @@ class SimRobot:
             self.blocked_reason = "endurance exhausted"
             return
         if self._status != FOLLOWING or self._path is None:
+            return
+        if self._stuck_s > 0:
+            self._stuck_s = max(0.0, self._stuck_s - dt_s)
             return
         budget = self._platform.speed_mps * dt_s
         while budget > 1e-9 and self._status == FOLLOWING:

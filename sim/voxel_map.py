@@ -79,7 +79,25 @@ class VoxelMap:
         occ[flat] = value
         self._dirty.reshape(-1)[flat] = True
 
+    def set_sphere(self, centre: np.ndarray, radius_m: float, value: int) -> None:
+        """Set every voxel within ``radius_m`` of ``centre`` to ``value``."""
+        r = int(np.ceil(radius_m / self.voxel_size_m))
+        c = np.floor((np.asarray(centre) - self.origin) / self.voxel_size_m).astype(np.int64)
+        span = np.arange(-r, r + 1)
+        d = np.stack(np.meshgrid(span, span, span, indexing="ij"), axis=-1).reshape(-1, 3)
+        d = d[(d**2).sum(axis=1) * self.voxel_size_m**2 <= radius_m**2]
+        axes = [c[a] + d[:, a] for a in range(3)]
+        nx, ny, nz = self.shape
+        i, j, k = axes
+        inside = (i >= 0) & (i < nx) & (j >= 0) & (j < ny) & (k >= 0) & (k < nz)
+        flat = ((i * ny + j) * nz + k)[inside]
+        self.occupancy.reshape(-1)[flat] = value
+        self._dirty.reshape(-1)[flat] = True
+        self._free_stale = True
+        self.version += 1
+
     def free_voxels(self) -> np.ndarray:
+
         """Flat indices of the FREE voxels, in the order they became free. Kept up to
         date as scans arrive, so planners need not scan the whole grid."""
         if self._new_free:
@@ -87,6 +105,9 @@ class VoxelMap:
             self._new_free = []
         if self._free_stale:
             self._free = self._free[self.occupancy.reshape(-1)[self._free] == FREE]
+            _, first = np.unique(self._free, return_index=True)  # a voxel freed twice
+            self._free = self._free[np.sort(first)]
+
             self._free_stale = False
         return self._free
 

@@ -6,9 +6,9 @@ from typing import Any
 import numpy as np
 from py_trees.common import Status
 
-from ..planners.frontier import FrontierGoal, frontier_clusters, frontier_voxels, nearest_frontier
+from ..planners.frontier import FrontierCluster, FrontierGoal, frontier_clusters, frontier_voxels, nearest_frontier
 from .base import Param, Skill
-from .navigation import navigator
+from .navigation import Plan, navigator
 from .robot import PathStatus
 
 
@@ -96,11 +96,6 @@ float, 2.0, "how often the target cluster is re-checked", exclusive_minimum=0),
     def _plan(self) -> Status:
         self.goal, self.arrived_s = None, None
         nav = navigator(self.ctx, self.robot)
-        plan = nav.from_robot()
-        if plan is None:
-            self.feedback_message = "robot is not on its navigation graph"
-            self.event("explore_failed", reason=self.feedback_message)
-            return Status.FAILURE
         grid = nav.grid()
         candidates = frontier_voxels(grid)
         candidates = candidates[~np.isin(candidates, self.blacklist)]
@@ -108,22 +103,20 @@ float, 2.0, "how often the target cluster is re-checked", exclusive_minimum=0),
                                      min_cluster_voxels=self.p["min_cluster_voxels"],
                                      max_extent_m=self.p["max_cluster_extent_m"])
         self.bb.set(self.k_left, len(clusters))
-        while True:
-            goal = nearest_frontier(plan.graph, plan.distances, clusters, max_goal_offset_m=self.p["max_goal_offset_m"],
-                                    view_up_deg=self.robot.view_up_deg)
-
-            if goal is None:
-                self.feedback_message = "no reachable frontier left"
-                self.event("exploration_complete", blacklisted_voxels=len(self.blacklist))
-                return Status.SUCCESS
-            if goal.node != plan.source:
+        # First on the cached navigation graph; if that ends at the robot, on a fresh one.
+        for fresh in (False, True):
+            plan = nav.from_robot(force=fresh)
+            if plan is None:
+                self.feedback_message = "robot is not on its navigation graph"
+                self.event("explore_failed", reason=self.feedback_message)
+                return Status.FAILURE
+            goal = self._choose(plan, clusters)
+            if goal is not None:
                 break
-            if goal.offset_m <= self.p["observe_radius_m"]:
-                # The robot stands next to the frontier and still sees it: it never will.
-                self.goal = goal
-                self._blacklist("unobservable from its goal")
-            # Otherwise the map does not reach any nearer yet: skip it this time.
-            clusters = [c for c in clusters if c is not goal.cluster]
+        else:
+            self.feedback_message = "no reachable frontier left"
+            self.event("exploration_complete", blacklisted_voxels=len(self.blacklist))
+            return Status.SUCCESS
         self.goal, self.checked_s = goal, self.ctx.clock.now_s
         self.robot.follow_path(plan.path_to(goal.node))
         self.bb.set(self.k_goal, _xyz(plan.graph.positions[goal.node]))
@@ -131,6 +124,20 @@ float, 2.0, "how often the target cluster is re-checked", exclusive_minimum=0),
         self.event("frontier_goal", at=_xyz(goal.cluster.centroid), path_length_m=round(goal.path_length_m, 2),
                    clusters=len(clusters))
         return Status.RUNNING
+
+    def _choose(self, plan: Plan, clusters: list[FrontierCluster]) -> FrontierGoal | None:
+        """The nearest frontier whose goal is not where the robot already stands."""
+        while True:
+            goal = nearest_frontier(plan.graph, plan.distances, clusters, max_goal_offset_m=self.p["max_goal_offset_m"],
+                                    view_up_deg=self.robot.view_up_deg)
+            if goal is None or goal.node != plan.source:
+                return goal
+            if goal.offset_m <= self.p["observe_radius_m"]:
+                # The robot stands next to the frontier and still sees it: it never will.
+                self.goal = goal
+                self._blacklist("unobservable from its goal")
+            # Otherwise the graph does not reach any nearer: skip it on this graph.
+            clusters = [c for c in clusters if c is not goal.cluster]
 
 
 def _xyz(p: np.ndarray) -> list[float]:

@@ -83,7 +83,7 @@ class Radio(Protocol):
         """Messages delivered since the last call."""
 
     def linked_to(self, other: str) -> bool:
-        """Whether a link to ``other`` exists right now."""
+        """Whether a link to ``other`` exists right now (directly or through the mesh)."""
 
     @property
     def pending(self) -> int:
@@ -155,6 +155,11 @@ class Robot(Protocol):
         """Start following ``path`` ((N, 3) waypoints); returns at once."""
 
     def stop(self) -> None: ...
+
+    def reset_local_map(self, radius_m: float) -> None:
+        """Forget the onboard map within ``radius_m`` of the robot; the next scans map
+        it again (the paper's reset of the elevation map after odometry artifacts)."""
+
 
     @property
     def path_status(self) -> PathStatus: ...

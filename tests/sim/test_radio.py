@@ -1,6 +1,7 @@
 """Unit tests for delve.sim.radio: link budgets in small carved worlds, the mesh
 through breadcrumbs, pings, and outboxes that lose nothing."""
 
+import itertools
 import math
 
 import networkx as nx
@@ -94,7 +95,7 @@ def test_straight_tunnel_links_past_100_m(straight):
         assert budgets[d].line_of_sight and budgets[d].rock_m == 0.0 and budgets[d].linked, d
     assert not budgets[135].linked and budgets[135].quality == 0.0
     q = [budgets[d].quality for d in (10, 50, 100, 110)]
-    assert all(a > b for a, b in zip(q, q[1:])), q
+    assert all(a > b for a, b in itertools.pairwise(q)), q
     assert budgets[10].quality > 0.9 and budgets[100].quality < 0.7
 
 
@@ -228,13 +229,12 @@ def test_multi_hop_loss_applies_per_hop_and_nothing_is_lost(straight):
         if not robot.pending:
             break
     assert sorted(got) == list(range(30))
-    hops = [net._links[(min(u, v), max(u, v))].loss for u, v in
-            zip(net.route("robot", "base"), net.route("robot", "base")[1:])]
+    hops = [net._links[(min(u, v), max(u, v))].loss for u, v in itertools.pairwise(net.route("robot", "base"))]
     assert len(hops) == 3 and min(hops) >= 0.3
 
 
 def test_breadcrumb_counts_and_refusals(straight):
-    net, clock = make_net(straight)
+    net, _ = make_net(straight)
     carrier = net.add("carrier", lambda: at(5))
     explorer = net.add("explorer", lambda: at(8), breadcrumbs=0)
     assert carrier.breadcrumbs == 4 and explorer.breadcrumbs == 0
@@ -275,7 +275,7 @@ def test_clients_do_not_relay(straight):
 
 
 def test_sim_robot_drops_breadcrumbs_on_the_ground(straight):
-    net, clock = make_net(straight)
+    net, _ = make_net(straight)
     holder = {}
     radio = net.add("anymal", lambda: holder["r"].position)
     robot = SimRobot("anymal", LEGGED, straight, np.array([30.0, 0.0, 0.0]), radio)

@@ -1,0 +1,448 @@
+"""GBPlanner2 skills: exploration with the local/global planner, and homing along its
+global graph (Kulkarni et al. 2022, section IV-A; CERBERUS SubT Final, section 3.3.1).
+
+One :class:`~delve.planners.gbplanner2.GBPlanner` per robot lives in the agent's
+``ctx.services`` (see :func:`gbplanner`), so that ``Explore``, ``Home`` and
+``GoTo`` (``planner: gbplanner``) share one global graph: the frontiers the local
+planner leaves behind, the visited positions, and the way home.
+"""
+from __future__ import annotations
+
+import zlib
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from py_trees.common import Access, Status
+
+from ..planners.gbplanner2 import GBPlanner, GBPlannerConfig, PlanResult
+from ..planners.occupancy import OCCUPIED, UNKNOWN, Grid
+from .base import AgentContext, Param, Skill
+from .navigation import navigator
+from .robot import PathStatus, Robot
+
+#: ``ctx.services`` key of the agent's :class:`PlannerService`.
+SERVICE = "gbplanner"
+
+
+@dataclass
+class PlannerService:
+    """The agent's GBPlanner2, its seeded random generator and the overrides it was
+    configured with."""
+
+    planner: GBPlanner
+    rng: np.random.Generator
+    overrides: dict[str, Any] = field(default_factory=dict)
+    plans: int = 0
+
+
+def robot_config(robot: Robot, overrides: dict[str, Any] | None = None) -> GBPlannerConfig:
+    """GBPlanner2's configuration for ``robot``: the Table I preset of its platform
+    (``legged``: ANYmal C, ``aerial``: RMF-Obelix), adapted to its mobility limits and
+    remaining endurance, then ``overrides`` (GBPlannerConfig field names) on top."""
+    mob = robot.mobility
+    preset = robot.platform if robot.platform in ("legged", "aerial") else ("aerial" if mob.aerial else "legged")
+    cfg = GBPlannerConfig.preset(preset).with_robot_limits(
+        speed_mps=mob.speed_mps,
+        body_height_m=mob.body_height_m,
+        radius_m=mob.radius_m,
+        max_inclination_deg=mob.max_inclination_deg,
+        max_step_m=mob.max_step_m,
+        endurance_s=max(robot.endurance_remaining_s, 1.0),
+    )
+    return cfg.replace(**overrides) if overrides else cfg
+
+
+def stable_seed(seed: int, agent: str) -> list[int]:
+    """Seed material for ``numpy.random.default_rng``: ``seed`` and a stable hash of the
+    agent's name (zlib.crc32, the same in every process, unlike ``hash()``)."""
+    return [int(seed), zlib.crc32(agent.encode("utf-8"))]
+
+
+def gbplanner(ctx: AgentContext, robot: Robot, overrides: dict[str, Any] | None = None, seed: int = 0) -> PlannerService:
+    """The agent's shared GBPlanner2, created on first use from :func:`robot_config`.
+
+    A later caller with other (non-empty) ``overrides`` reconfigures the planner and
+    keeps its global graph; callers without overrides use it as it is.
+    """
+    svc = ctx.services.get(SERVICE)
+    if svc is None:
+        planner = GBPlanner(robot_config(robot, overrides), robot.home)
+        svc = ctx.services[SERVICE] = PlannerService(planner, np.random.default_rng(stable_seed(seed, ctx.name)),
+                                                     dict(overrides or {}))
+    elif overrides and overrides != svc.overrides:
+        cfg = robot_config(robot, overrides).replace(endurance_s=svc.planner.config.endurance_s)
+        svc.planner.config = cfg
+        svc.planner.local_planner.config = cfg
+        svc.planner.global_planner.config = cfg
+        svc.overrides = dict(overrides)
+    return svc
+
+
+def onboard_grid(ctx: AgentContext, robot: Robot) -> Grid:
+    """The robot's onboard map as a planner grid."""
+    return navigator(ctx, robot).grid()
+
+
+def sealed_grid(grid: Grid) -> Grid:
+    """A copy of ``grid`` in which UNKNOWN voxels that share a face with an OCCUPIED one
+    are OCCUPIED: the mapped rock surface, one voxel thick, has gaps where the LiDAR's
+    returns fell on a neighbouring voxel, and the planner's gain rays (one voxel per
+    step) slip through them into the unknown rock behind, which then looks like
+    hundreds of m3 of unexplored space forever. Openings wider than two voxels stay
+    open, so real frontiers keep their gain."""
+    occ = grid.occupancy
+    rock = occ == OCCUPIED
+    near = np.zeros_like(rock)
+    for ax in range(3):
+        lo = [slice(None)] * 3
+        hi = [slice(None)] * 3
+        lo[ax], hi[ax] = slice(None, -1), slice(1, None)
+        near[tuple(lo)] |= rock[tuple(hi)]
+        near[tuple(hi)] |= rock[tuple(lo)]
+    out = occ.copy()
+    out[near & (occ == UNKNOWN)] = OCCUPIED
+    return Grid(out, grid.origin, grid.voxel_size_m, grid.free)
+
+
+def parse_bbox(value: Any) -> tuple[np.ndarray, np.ndarray] | None:
+    """An exploration bounding box from the blackboard: ``{min: [x, y, z], max: [x, y, z]}``
+    or ``[[x, y, z], [x, y, z]]`` (either corner order); None when unset.
+
+    Raises ValueError for anything else."""
+    if value is None:
+        return None
+    if isinstance(value, dict):
+        if "min" not in value or "max" not in value:
+            raise ValueError(f"exploration box needs 'min' and 'max' corners, got keys {sorted(value)}")
+        a, b = value["min"], value["max"]
+    elif isinstance(value, (list, tuple, np.ndarray)) and len(value) == 2:
+        a, b = value
+    else:
+        raise ValueError(f"exploration box must be {{min: [x, y, z], max: [x, y, z]}}, got {value!r}")
+    a, b = np.asarray(a, float).reshape(-1), np.asarray(b, float).reshape(-1)
+    if a.shape != (3,) or b.shape != (3,) or not (np.all(np.isfinite(a)) and np.all(np.isfinite(b))):
+        raise ValueError(f"exploration box corners must be three finite numbers each, got {value!r}")
+    return np.minimum(a, b), np.maximum(a, b)
+
+
+def _xyz(p: np.ndarray) -> list[float]:
+    return [round(float(v), 3) for v in p]
+
+
+def _length(path: np.ndarray) -> float:
+    return float(np.linalg.norm(np.diff(path, axis=0), axis=1).sum()) if len(path) > 1 else 0.0
+
+
+# Planner parameters a tree may override: the YAML name -> GBPlannerConfig field.
+_OVERRIDES = {
+    "max_vertices": "num_vertices_max",
+    "rho_m": "clustering_radius_m",
+    "gamma_h": "hanging_vertex_penalty",
+    "sensor_range_m": "sensor_range_m",
+    "traverse_length_max_m": "traverse_length_max_m",
+    "low_gain_iterations": "low_gain_iterations_max",
+}
+
+
+#: Codes ``Explore`` writes to ``last_plan_reason``.
+PLAN_REASONS = ("ok", "reposition", "homing_due", "exploration_complete", "invalid_start", "no_path", "error")
+
+# Local planner reasons that mean the robot's start pose is invalid on its map.
+_INVALID_START = ("start position is invalid", "robot position is outside the map", "robot position is not finite")
+
+
+def plan_reason(res: PlanResult) -> str:
+    """The code of a :class:`PlanResult` (one of :data:`PLAN_REASONS` but ``error``)."""
+    if res.homing is not None and res.homing.required:
+        return "homing_due"
+    if res.ok:
+        return "reposition" if res.mode == "reposition" else "ok"
+    if res.exploration_complete:
+        return "exploration_complete"
+    local = res.local.reason if res.local is not None else res.reason
+    if any(local.startswith(s) for s in _INVALID_START):
+        return "invalid_start"
+    return "no_path"
+
+
+class Explore(Skill):
+    """GBPlanner2 exploration: plan one iteration, follow its path, repeat.
+
+    Each iteration is :meth:`GBPlanner.plan`: the local planner (Algorithm 1) on the
+    onboard map; the global planner repositions the robot to the best frontier when
+    the local gain stayed low for ``low_gain_iterations`` iterations or the local
+    planner found no path; with ``endurance_homing`` it also checks at every iteration
+    whether the remaining endurance still covers one more step and the way home.
+    With ``relocate``, the first iteration goes to the best frontier of the global
+    graph (the supervisor's "relocate to a frontier, then explore").
+    The next iteration starts when the robot has arrived (or its path was blocked).
+    The planner's parameters come from the robot's platform (Table I preset: ``legged``
+    ANYmal C, ``aerial`` RMF-Obelix) and its mobility limits; the parameters below that
+    are not null override them, and ``planner`` overrides any GBPlannerConfig field.
+    Randomness comes from a generator seeded with ``seed`` and the agent's name.
+
+    Reads: ``exploration_bbox`` (optional ``{min: [x, y, z], max: [x, y, z]}`` or
+    ``[min, max]``): the local graph stays inside it and only frontiers inside it are
+    repositioned to.
+    Writes: ``planner_mode`` (explore, reposition, homing, none),
+    ``last_plan_reason`` (ok, reposition, homing_due, exploration_complete,
+    invalid_start, no_path, error), ``last_plan_detail`` (the planner's words),
+    ``exploration_complete`` (True when nothing is left to explore), ``homing_due``
+    (True when the planner decided that the endurance calls for homing).
+    Returns: RUNNING while exploring (also after a failed iteration, which is retried
+    after ``retry_period_s``); SUCCESS when the exploration is complete or homing is
+    due (the tree's ``Home`` then walks the way home); FAILURE at once when the start
+    pose is invalid or the planner raises, and after ``max_failed_plans`` failed
+    iterations in a row (the reason is logged as ``explore_failed``).
+    """
+
+    PARAMS = {
+        "seed": Param(int, 0, "seeds the planner's random generator (with the agent's name)", minimum=0),
+        "endurance_homing": Param(bool, True, "the planner checks at each iteration whether to go home"),
+        "relocate": Param(bool, False, "first go to the best frontier of the global graph, then explore"),
+        "max_failed_plans": Param(int, 3, "failed iterations in a row before FAILURE", minimum=1),
+        "retry_period_s": Param(float, 2.0, "wait before retrying a failed iteration", minimum=0),
+        "max_vertices": Param(int, None, "N_V,max, vertices of the local graph (null: preset, 1000 / 500)",
+                              minimum=2, nullable=True),
+        "rho_m": Param(float, None, "clustering radius of the leaf-only gain (0 disables; null: preset, 0 / 1 m)",
+                       minimum=0, nullable=True),
+        "gamma_h": Param(float, None, "hanging-vertex gain penalty gamma_H, gain times exp(-gamma_H) (null: 5)",
+                         minimum=0, nullable=True),
+        "sensor_range_m": Param(float, None, "d_max, sensor range of the gain model (null: preset, 30 m)",
+                                exclusive_minimum=0, nullable=True),
+        "traverse_length_max_m": Param(float, None, "commanded paths are cut to this length (null: preset, 12 / 10 m)",
+                                       exclusive_minimum=0, nullable=True),
+        "low_gain_iterations": Param(int, None, "low-gain iterations before repositioning (null: preset, 3)",
+                                     minimum=1, nullable=True),
+        "planner": Param(dict, {}, "further GBPlannerConfig overrides by field name, e.g. {leaf_only_gain: true}"),
+        "seal_map_holes": Param(bool, True, "the planner sees unknown voxels next to mapped rock as rock"),
+    }
+
+    def __init__(self, name: str, ctx: Any, remap: dict[str, str] | None = None, **params: Any):
+        super().__init__(name, ctx, remap, **params)
+        self.overrides = {field: self.p[p] for p, field in _OVERRIDES.items() if self.p.get(p) is not None}
+        self.overrides.update(self.p["planner"])
+        # Unknown names and impossible values fail when the tree is built (file and line).
+        GBPlannerConfig.preset("legged").replace(**self.overrides)
+        self.k_mode = self.key("planner_mode")
+        self.k_reason = self.key("last_plan_reason")
+        self.k_detail = self.key("last_plan_detail")
+        self.k_complete = self.key("exploration_complete")
+        self.k_homing = self.key("homing_due")
+        self.k_bbox = self.key("exploration_bbox", Access.READ)
+        self.following = False
+        self.failures = 0
+        self.next_plan_s = -float("inf")
+        self.relocate_pending = False
+
+    def initialise(self) -> None:
+        self.following, self.failures, self.next_plan_s = False, 0, -float("inf")
+        self.relocate_pending = self.p["relocate"]
+
+    def update(self) -> Status:
+        r = self.robot
+        if self.following:
+            status = r.path_status
+            if status == PathStatus.FOLLOWING:
+                return Status.RUNNING
+            self.following = False
+            if status == PathStatus.BLOCKED:
+                self.event("explore_path_blocked", reason=getattr(r, "blocked_reason", ""))
+        if self.ctx.clock.now_s < self.next_plan_s:
+            return Status.RUNNING
+        return self._plan()
+
+    def terminate(self, new_status: Status) -> None:
+        if new_status == Status.INVALID and self.following and self.ctx.robot is not None:
+            self.robot.stop()
+        self.following = False
+
+    def _plan(self) -> Status:
+        r = self.robot
+        try:
+            svc = gbplanner(self.ctx, r, self.overrides, self.p["seed"])
+            bounds = parse_bbox(self.get(self.k_bbox))
+            grid = onboard_grid(self.ctx, r)
+            if self.p["seal_map_holes"]:
+                grid = sealed_grid(grid)
+            res = self._call(svc, grid, bounds)
+        except Exception as err:  # a failed planner call never crashes the tree
+            detail = f"{type(err).__name__}: {err}"
+            self._write("none", "error", detail)
+            self.feedback_message = detail
+            self.event("explore_failed", reason="error", detail=detail)
+            return Status.FAILURE
+        svc.plans += 1
+        code = plan_reason(res)
+        self._write(res.mode, code, res.reason)
+        if code == "homing_due":
+            assert res.homing is not None
+            self.bb.set(self.k_homing, True)
+            self.feedback_message = "homing due: " + res.reason
+            self.event("planner_homing", trigger=True, endurance_s=round(r.endurance_remaining_s, 1),
+                       time_home_s=round(res.homing.time_home_s, 1), detail=res.reason)
+            return Status.SUCCESS
+        if res.ok:
+            assert res.path is not None
+            self.failures = 0
+            r.follow_path(res.path)
+            self.following = True
+            length = _length(res.path)
+            self.feedback_message = f"{res.mode}: {length:.1f} m, gain {res.gain:.0f} m3"
+            self.event("gbplanner_path", mode=res.mode, gain_m3=round(res.gain, 1), path_length_m=round(length, 2),
+                       to=_xyz(res.path[-1]), frontiers=len(svc.planner.global_planner.frontiers))
+            return Status.RUNNING
+        if code == "exploration_complete":
+            self.bb.set(self.k_complete, True)
+            self.feedback_message = "exploration complete"
+            self.event("exploration_complete", detail=res.reason, iterations=svc.plans)
+            return Status.SUCCESS
+        self.failures += 1
+        self.event("plan_failed", reason=code, detail=res.reason, attempt=self.failures)
+        if code == "invalid_start" or self.failures >= self.p["max_failed_plans"]:
+            self.feedback_message = f"{code}: {res.reason}"
+            self.event("explore_failed", reason=code, detail=res.reason)
+            return Status.FAILURE
+        self.next_plan_s = self.ctx.clock.now_s + self.p["retry_period_s"]
+        self.feedback_message = f"retrying: {res.reason}"
+        return Status.RUNNING
+
+    def _call(self, svc: PlannerService, grid: Grid, bounds: tuple[np.ndarray, np.ndarray] | None) -> PlanResult:
+        r = self.robot
+        planner = svc.planner
+        gp = planner.global_planner
+        endurance = r.endurance_remaining_s if self.p["endurance_homing"] else None
+        hidden = {}
+        if bounds is not None:
+            # Repositioning considers only the frontiers inside the box (the others are
+            # kept for later, when the box is lifted).
+            lo, hi = bounds
+            hidden = {v: f for v, f in gp.frontiers.items() if not np.all((f.position >= lo) & (f.position <= hi))}
+            for v in hidden:
+                del gp.frontiers[v]
+        try:
+            if self.relocate_pending:
+                self.relocate_pending = False
+                gp.record_position(r.position)
+                rep = gp.plan_reposition(grid, r.position, endurance)
+                if rep.ok:
+                    return PlanResult(rep.path, "reposition", rep.gain, "relocation to the best frontier",
+                                      global_result=rep)
+                self.event("relocate_failed", detail=rep.reason)
+            return planner.plan(grid, r.position, svc.rng, yaw_rad=r.yaw_rad, endurance_remaining_s=endurance,
+                                exploration_bounds=bounds)
+        finally:
+            gp.frontiers.update(hidden)
+
+    def _write(self, mode: str, code: str, detail: str) -> None:
+        self.bb.set(self.k_mode, mode)
+        self.bb.set(self.k_reason, code)
+        self.bb.set(self.k_detail, detail)
+        self.bb.set(self.k_complete, code == "exploration_complete")
+        self.bb.set(self.k_homing, code == "homing_due")
+
+
+class Home(Skill):
+    """Go home: along GBPlanner2's global graph (the planner's homing path); when it has
+    no path, or its path turned out blocked, along the navigation graph of the onboard
+    map; and when that fails too, back along the robot's own traversed path (loops cut
+    out), which it has walked before.
+
+    Writes: ``returned_home`` (True on arrival), ``planner_mode`` (``homing``).
+    Returns: RUNNING on the way; SUCCESS within ``tolerance_m`` of home; FAILURE when
+    no path home is found, or after ``max_replans`` re-plans (blocked paths, or
+    arrivals short of home).
+    """
+
+    #: Where a path home comes from, in the order they are tried.
+    SOURCES = ("gbplanner2", "navigator", "traversed_path")
+
+    PARAMS = {
+        "tolerance_m": Param(float, 1.0, "distance to home that counts as home", exclusive_minimum=0),
+        "max_replans": Param(int, 5, "re-plans allowed after a blocked path or an arrival short of home", minimum=0),
+    }
+
+    def __init__(self, name: str, ctx: Any, remap: dict[str, str] | None = None, **params: Any):
+        super().__init__(name, ctx, remap, **params)
+        self.k_home = self.key("returned_home")
+        self.k_mode = self.key("planner_mode")
+        self.replans = 0
+        self.moving = False
+        self.first_source = 0
+        self.source = 0
+
+    def initialise(self) -> None:
+        self.replans, self.moving, self.first_source, self.source = 0, False, 0, 0
+
+    def update(self) -> Status:
+        r = self.robot
+        if np.linalg.norm(r.position - r.home) <= self.p["tolerance_m"]:
+            if self.moving:
+                r.stop()
+            self.moving = False
+            self.bb.set(self.k_home, True)
+            self.event("home_reached", endurance_s=round(r.endurance_remaining_s, 1))
+            return Status.SUCCESS
+        if self.moving:
+            status = r.path_status
+            if status == PathStatus.FOLLOWING:
+                return Status.RUNNING
+            self.moving = False
+            self.replans += 1
+            # A blocked path: the next source; an arrival short of home: from the top.
+            self.first_source = (self.source + 1) % len(self.SOURCES) if status == PathStatus.BLOCKED else 0
+            if status == PathStatus.BLOCKED:
+                self.event("homing_path_blocked", source=self.SOURCES[self.source],
+                           reason=getattr(r, "blocked_reason", ""))
+            if self.replans > self.p["max_replans"]:
+                return self._fail(f"not home after {self.replans - 1} re-plans "
+                                  f"({getattr(r, 'blocked_reason', '') or status})")
+        path = None
+        for k in range(len(self.SOURCES)):
+            self.source = (self.first_source + k) % len(self.SOURCES)
+            try:
+                path = self._path(self.SOURCES[self.source])
+            except Exception as err:  # a failed planner call never crashes the tree
+                self.event("homing_planner_error", source=self.SOURCES[self.source],
+                           reason=f"{type(err).__name__}: {err}")
+                path = None
+            if path is not None and len(path):
+                break
+        if path is None or not len(path):
+            return self._fail("no path home")
+        path = np.vstack([path, r.home])
+        r.follow_path(path)
+        self.moving = True
+        self.bb.set(self.k_mode, "homing")
+        length = _length(np.vstack([r.position, path]))
+        source = self.SOURCES[self.source]
+        self.feedback_message = f"home is {length:.0f} m away ({source})"
+        self.event("homing", source=source, path_length_m=round(length, 1))
+        return Status.RUNNING
+
+    def _path(self, source: str) -> np.ndarray | None:
+        r = self.robot
+        if source == "gbplanner2":
+            res = gbplanner(self.ctx, r).planner.home(onboard_grid(self.ctx, r), r.position)
+            return res.path if res.ok else None
+        if source == "navigator":
+            path, _ = navigator(self.ctx, r).path_to_point(r.home, force=True)
+            return path
+        from .motion import backtrack_path, max_jump_dz
+
+        return backtrack_path(r.traversed_path, None, max_jump_dz_m=max_jump_dz(r))
+
+    def _fail(self, reason: str) -> Status:
+        self.feedback_message = reason
+        self.event("homing_failed", reason=reason)
+        return Status.FAILURE
+
+    def terminate(self, new_status: Status) -> None:
+        if new_status == Status.INVALID and self.moving and self.ctx.robot is not None:
+            self.robot.stop()
+        self.moving = False
+
+
+__all__ = ["PLAN_REASONS", "Explore", "Home", "PlannerService", "gbplanner", "onboard_grid", "parse_bbox",
+           "plan_reason", "robot_config", "sealed_grid", "stable_seed"]

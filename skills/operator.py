@@ -1,0 +1,95 @@
+"""Supervisor commands: what the Human Supervisor can ask of a robot, and the skill
+that turns commands arriving over the radio into blackboard state for the tree.
+
+The commands are the CERBERUS paper's operator calls and its four modes of
+operation: explore within radio range (backing off when the link drops), explore
+with a time budget out of range, relocate to a frontier then explore, and go to a
+waypoint; plus setting the exploration bounding box, homing, cancelling, scanning
+the area or a point, and dropping a breadcrumb.
+"""
+from __future__ import annotations
+
+from typing import Any
+
+from py_trees.common import Status
+
+from .base import Param, Skill
+
+COMMAND = "command"
+GOAL_UNREACHABLE = "goal_unreachable"
+
+#: Each command's arguments. The executive checks supervisor scripts against these.
+COMMANDS: dict[str, dict[str, Param]] = {
+    "explore": {"budget_s": Param(float, None, "time budget for exploring out of radio range; none: stay in range",
+                                  minimum=0, nullable=True)},
+    "set_bbox": {"min": Param(list, doc="lower corner [x, y, z] of the exploration bounding box (m)"),
+                 "max": Param(list, doc="upper corner [x, y, z] (m)")},
+    "home": {},
+    "cancel": {},
+    "relocate": {},
+    "scan": {"point": Param(list, None, "point [x, y, z] to inspect; none: scan the area", nullable=True)},
+    "goto": {"goal": Param(list, doc="waypoint [x, y, z] (m)")},
+    "drop_breadcrumb": {},
+}
+
+#: Blackboard values of ``mode``.
+MODES = ("idle", "explore", "relocate", "goto", "home")
+
+
+class ProcessOperatorCommands(Skill):
+    """Process Operator Calls: apply every supervisor command that has arrived.
+
+    Reads radio messages of kind ``command`` (kept in the outbox of the base station
+    while the link is down). Writes ``mode`` (idle, explore, relocate, goto, home),
+    ``time_budget_s`` and ``budget_start_s`` (explore with a budget), ``goal`` and
+    ``goal_source`` (goto), ``exploration_bbox``, ``inspection_request`` (scan),
+    ``breadcrumb_request`` and ``last_command``. Commands take priority over onboard
+    requests: a new command replaces the running one. Returns RUNNING (it is a
+    background task).
+    """
+
+    PARAMS = {"initial_mode": Param(str, "idle", "mode before the first command", choices=MODES)}
+
+    def __init__(self, name: str, ctx: Any, remap: dict[str, str] | None = None, **params: Any):
+        super().__init__(name, ctx, remap, **params)
+        keys = ("mode", "time_budget_s", "budget_start_s", "goal", "goal_source", "exploration_bbox",
+                "inspection_request", "breadcrumb_request", "last_command")
+        self.k = {k: self.key(k) for k in keys}
+
+    def setup(self, **kwargs: Any) -> None:
+        self.bb.set(self.k["mode"], self.p["initial_mode"])
+        for k in ("time_budget_s", "budget_start_s", "goal", "goal_source", "exploration_bbox", "inspection_request"):
+            self.bb.set(self.k[k], None)
+        self.bb.set(self.k["breadcrumb_request"], False)
+        self.bb.set(self.k["last_command"], None)
+
+    def update(self) -> Status:
+        for msg in self.robot.radio.receive():
+            if msg.kind == COMMAND:
+                self._apply(msg.data["command"], msg.data.get("args", {}))
+        return Status.RUNNING
+
+    def _apply(self, command: str, args: dict[str, Any]) -> None:
+        now, set_ = self.ctx.clock.now_s, self.bb.set
+        if command == "explore":
+            set_(self.k["mode"], "explore")
+            budget = args.get("budget_s")
+            set_(self.k["time_budget_s"], budget)
+            set_(self.k["budget_start_s"], now if budget is not None else None)
+        elif command == "set_bbox":
+            set_(self.k["exploration_bbox"], [list(args["min"]), list(args["max"])])
+        elif command in ("home", "relocate"):
+            set_(self.k["mode"], command)
+        elif command == "cancel":
+            set_(self.k["mode"], "idle")
+            self.robot.stop()
+        elif command == "goto":
+            set_(self.k["mode"], "goto")
+            set_(self.k["goal"], list(args["goal"]))
+            set_(self.k["goal_source"], "supervisor")
+        elif command == "scan":
+            set_(self.k["inspection_request"], {"point": args.get("point"), "requested_s": now})
+        elif command == "drop_breadcrumb":
+            set_(self.k["breadcrumb_request"], True)
+        set_(self.k["last_command"], command)
+        self.event("operator_command", trigger=True, command=command, **{k: v for k, v in args.items()})

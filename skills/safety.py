@@ -1,0 +1,110 @@
+"""Safety conditions of the ANYmal behaviour tree: the watchdog, the homing timer and
+the link to the base station (the CERBERUS paper, section 3.3.3, Figures 13–15)."""
+from __future__ import annotations
+
+from collections import deque
+from typing import Any
+
+import numpy as np
+from py_trees.common import Access, Status
+
+from .base import Param, Skill
+from .robot import PathStatus
+
+BASE = "base"
+
+
+class RobotStuck(Skill):
+    """Watchdog: a motion command is active but the robot has not moved.
+
+    Keeps the robot's positions over the last ``stuck_time_s`` while it follows a
+    path. Returns SUCCESS (and logs a ``watchdog`` trigger) when it has followed a
+    path for ``stuck_time_s`` and moved less than ``min_motion_m`` in that time;
+    FAILURE otherwise.
+    """
+
+    PARAMS = {
+        "stuck_time_s": Param(float, 20.0, "time without motion that counts as stuck", exclusive_minimum=0),
+        "min_motion_m": Param(float, 0.3, "less motion than this in stuck_time_s is no motion", exclusive_minimum=0),
+    }
+
+    def __init__(self, name: str, ctx: Any, remap: dict[str, str] | None = None, **params: Any):
+        super().__init__(name, ctx, remap, **params)
+        self.history: deque[tuple[float, np.ndarray]] = deque()
+
+    def update(self) -> Status:
+        r, now = self.robot, self.ctx.clock.now_s
+        if r.path_status != PathStatus.FOLLOWING:
+            self.history.clear()
+            return Status.FAILURE
+        self.history.append((now, r.position))
+        while len(self.history) > 1 and now - self.history[1][0] >= self.p["stuck_time_s"]:
+            self.history.popleft()
+        t0, p0 = self.history[0]
+        if now - t0 >= self.p["stuck_time_s"] and np.linalg.norm(r.position - p0) < self.p["min_motion_m"]:
+            self.history.clear()
+            self.feedback_message = f"no motion for {self.p['stuck_time_s']:.0f} s"
+            self.event("watchdog", trigger=True, position=[round(float(v), 2) for v in r.position])
+            return Status.SUCCESS
+        return Status.FAILURE
+
+
+class BudgetElapsed(Skill):
+    """Homing timer: the supervisor's time budget for exploring out of range is spent.
+
+    Reads ``time_budget_s`` and ``budget_start_s`` (written by
+    ProcessOperatorCommands). Returns SUCCESS (and logs a ``homing_timer`` trigger)
+    once the budget has elapsed; FAILURE while it has not, or when no budget is set.
+    """
+
+    def __init__(self, name: str, ctx: Any, remap: dict[str, str] | None = None, **params: Any):
+        super().__init__(name, ctx, remap, **params)
+        self.k_budget = self.key("time_budget_s", Access.READ)
+        self.k_start = self.key("budget_start_s", Access.READ)
+        self.fired = False
+
+    def update(self) -> Status:
+        budget, start = self.get(self.k_budget), self.get(self.k_start)
+        if budget is None or start is None or self.ctx.clock.now_s - start < budget:
+            self.fired = False
+            return Status.FAILURE
+        if not self.fired:
+            self.event("homing_timer", trigger=True, budget_s=budget)
+            self.fired = True
+        return Status.SUCCESS
+
+
+class Ping(Skill):
+    """Ping the base station every ``period_s``; a ping can fail.
+
+    Writes ``ping_ok`` (the last ping's result) and ``failed_pings`` (consecutive
+    failures). Returns RUNNING (it is a background task).
+    """
+
+    PARAMS = {
+        "period_s": Param(float, 2.0, "time between pings", exclusive_minimum=0),
+        "target": Param(str, BASE, "who is pinged"),
+    }
+
+    def __init__(self, name: str, ctx: Any, remap: dict[str, str] | None = None, **params: Any):
+        super().__init__(name, ctx, remap, **params)
+        self.k_ok = self.key("ping_ok")
+        self.k_failed = self.key("failed_pings")
+        self.next_s = 0.0
+        self.failed = 0
+
+    def setup(self, **kwargs: Any) -> None:
+        self.bb.set(self.k_ok, True)
+        self.bb.set(self.k_failed, 0)
+
+    def update(self) -> Status:
+        now = self.ctx.clock.now_s
+        if now + 1e-9 >= self.next_s:
+            self.next_s = now + self.p["period_s"]
+            ok = bool(self.robot.radio.ping(self.p["target"]))
+            self.failed = 0 if ok else self.failed + 1
+            self.bb.set(self.k_ok, ok)
+            self.bb.set(self.k_failed, self.failed)
+        return Status.RUNNING
+
+
