@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .payload import PanTiltZoomCamera
 from .platforms import Platform
 from .radio import BREADCRUMB_ANTENNA_HEIGHT_M, BreadcrumbDrop
 from .voxel_map import OCCUPIED, UNKNOWN, VoxelMap
@@ -68,8 +69,12 @@ class SimRobot:
         self._status = IDLE
         self.blocked_reason = ""
         self._scans = 0
+        self._commands = 0
+
         self._stuck_s = 0.0
         self._parked = False
+
+        self._payload: PanTiltZoomCamera | None = None
 
         self._sensors = [(spec, spec.beam_directions(0.0)) for spec in (platform.lidar, platform.terrain) if spec]
 
@@ -149,6 +154,22 @@ class SimRobot:
         return self._radio.deploy_breadcrumb(spot)
 
     @property
+    def remaining_path(self) -> np.ndarray:
+        """(M, 3) waypoints of the path being followed not reached yet, the next one
+        first; (0, 3) when the robot follows none."""
+        if self._status != FOLLOWING or self._path is None:
+            return np.zeros((0, 3))
+        return self._path[self._wp:].copy()
+
+    @property
+    def payload(self) -> PanTiltZoomCamera | None:
+        """The pan-tilt-zoom inspection camera (the paper's values), created on first
+        use. Legged robots carry it, as the ANYmal Explorers did; aerial robots do not."""
+        if self._payload is None and not self._platform.aerial:
+            self._payload = PanTiltZoomCamera(self.world)
+        return self._payload
+
+    @property
     def alive(self) -> bool:
         return self._endurance > 0
 
@@ -158,9 +179,12 @@ class SimRobot:
         self._stuck_s = max(self._stuck_s, duration_s)
 
     def inject_map_artifact(self, radius_m: float = 1.5) -> None:
-        """A fault: rock appears in the onboard map all around the robot, as odometry
-        drift leaves in a real map, so planners find its start pose invalid."""
+        """A fault: the state estimator jumps, the robot halts, and rock appears in its
+        onboard map all around it, as odometry drift leaves in a real map, so planners
+        find its start pose invalid."""
+        self.stop()
         self._map.set_sphere(self._pos, radius_m, OCCUPIED)
+
 
     def reset_local_map(self, radius_m: float) -> None:
         """Forget the onboard map within ``radius_m`` of the robot (the next scans
@@ -172,7 +196,13 @@ class SimRobot:
         self.stop()
         self._parked = True
 
+    @property
+    def command_id(self) -> int:
+        """Counts motion commands (``follow_path`` and ``stop``)."""
+        return self._commands
+
     def follow_path(self, path: np.ndarray) -> None:
+        self._commands += 1
         path = np.asarray(path, dtype=float).reshape(-1, 3)
         if len(path) == 0 or not np.all(np.isfinite(path)):
             self._status, self.blocked_reason = BLOCKED, "empty or non-finite path"
@@ -180,6 +210,7 @@ class SimRobot:
         self._path, self._wp, self._status, self.blocked_reason = path, 0, FOLLOWING, ""
 
     def stop(self) -> None:
+        self._commands += 1
         self._path = None
         if self._status == FOLLOWING:
             self._status = IDLE

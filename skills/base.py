@@ -144,7 +144,20 @@ class Skill(py_trees.behaviour.Behaviour):
         except KeyError:
             return default
 
+    def follow(self, path: Any) -> None:
+        """Command the robot along ``path`` and remember that this behaviour did."""
+        self.robot.follow_path(path)
+        self._command_id = self.robot.command_id
+
+    def stop_own_motion(self) -> None:
+        """Stop the robot if it still follows this behaviour's last command (a
+        behaviour stopped because another took over must not cancel the newcomer's
+        command, which py_trees issues before it stops the old one)."""
+        if self.ctx.robot is not None and getattr(self, "_command_id", None) == self.robot.command_id:
+            self.robot.stop()
+
     def event(self, event: str, **fields: Any) -> None:
+
         """Log an event of this behaviour with the agent's name and the sim time."""
         self.ctx.log(event, agent=self.ctx.name, node=self.name, **fields)
 

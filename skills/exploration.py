@@ -57,7 +57,7 @@ float, 2.0, "how often the target cluster is re-checked", exclusive_minimum=0),
 
     def terminate(self, new_status: Status) -> None:
         if new_status == Status.INVALID and self.ctx.robot is not None:
-            self.robot.stop()
+            self.stop_own_motion()
         self.goal = None
 
     def _remaining(self) -> int:
@@ -73,7 +73,7 @@ float, 2.0, "how often the target cluster is re-checked", exclusive_minimum=0),
                 return False
             self.checked_s = now
             if self._remaining() <= (1 - self.p["explored_fraction"]) * goal.cluster.size:
-                self.robot.stop()
+                self.stop_own_motion()
                 return True
             return False
         if status == PathStatus.ARRIVED:
@@ -118,7 +118,7 @@ float, 2.0, "how often the target cluster is re-checked", exclusive_minimum=0),
             self.event("exploration_complete", blacklisted_voxels=len(self.blacklist))
             return Status.SUCCESS
         self.goal, self.checked_s = goal, self.ctx.clock.now_s
-        self.robot.follow_path(plan.path_to(goal.node))
+        self.follow(plan.path_to(goal.node))
         self.bb.set(self.k_goal, _xyz(plan.graph.positions[goal.node]))
         self.feedback_message = f"to frontier {goal.path_length_m:.1f} m away"
         self.event("frontier_goal", at=_xyz(goal.cluster.centroid), path_length_m=round(goal.path_length_m, 2),

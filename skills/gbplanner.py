@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 from py_trees.common import Access, Status
 
-from ..planners.gbplanner2 import GBPlanner, GBPlannerConfig, PlanResult
+from ..planners.gbplanner2 import GBPlanner, GBPlannerConfig, LocalBound, LocalPlanner, LocalPlanResult, PlanResult
 from ..planners.occupancy import OCCUPIED, UNKNOWN, Grid
 from .base import AgentContext, Param, Skill
 from .navigation import navigator
@@ -34,6 +34,38 @@ class PlannerService:
     rng: np.random.Generator
     overrides: dict[str, Any] = field(default_factory=dict)
     plans: int = 0
+
+
+class ShrinkingLocalPlanner(LocalPlanner):
+    """The local planner, re-run in a smaller local bounding box when the adaptive box
+    gave a local graph of (almost) no vertices.
+
+    The adaptive box spans the PCA of all mapped points within mu_V (50 m); where the
+    robot stands in a narrow passage next to a wider network (a ramp up from a
+    junction, say), the box is mostly rock and unknown space, and graph building stops
+    after its first batch of samples because so few were free. Halving the box (down
+    to ``bounding_box_size_min_m``) keeps its orientation and fills it with vertices.
+    """
+
+    #: A graph with fewer vertices than this is re-built in a smaller box.
+    min_vertices = 10
+    #: At most this many halvings.
+    max_shrinks = 2
+
+    def plan(self, grid: Grid, position: np.ndarray, rng: np.random.Generator, *,
+             bound: LocalBound | None = None, **kw: Any) -> LocalPlanResult:
+        res = super().plan(grid, position, rng, bound=bound, **kw)
+        size_min = 0.5 * np.sort(np.asarray(self.config.bounding_box_size_min_m, float))[::-1]
+        for _ in range(self.max_shrinks):
+            g = res.graph
+            if bound is not None or g is None or g.bound is None or g.num_vertices >= self.min_vertices:
+                break
+            b = g.bound
+            half = np.maximum(0.5 * b.half_extents_m, size_min)
+            if np.allclose(half, b.half_extents_m):
+                break
+            res = super().plan(grid, position, rng, bound=LocalBound(b.centre, b.axes, half, b.num_points), **kw)
+        return res
 
 
 def robot_config(robot: Robot, overrides: dict[str, Any] | None = None) -> GBPlannerConfig:
@@ -68,12 +100,13 @@ def gbplanner(ctx: AgentContext, robot: Robot, overrides: dict[str, Any] | None 
     svc = ctx.services.get(SERVICE)
     if svc is None:
         planner = GBPlanner(robot_config(robot, overrides), robot.home)
+        planner.local_planner = ShrinkingLocalPlanner(planner.config)
         svc = ctx.services[SERVICE] = PlannerService(planner, np.random.default_rng(stable_seed(seed, ctx.name)),
                                                      dict(overrides or {}))
     elif overrides and overrides != svc.overrides:
         cfg = robot_config(robot, overrides).replace(endurance_s=svc.planner.config.endurance_s)
         svc.planner.config = cfg
-        svc.planner.local_planner.config = cfg
+        svc.planner.local_planner = ShrinkingLocalPlanner(cfg)
         svc.planner.global_planner.config = cfg
         svc.overrides = dict(overrides)
     return svc
@@ -255,7 +288,7 @@ class Explore(Skill):
 
     def terminate(self, new_status: Status) -> None:
         if new_status == Status.INVALID and self.following and self.ctx.robot is not None:
-            self.robot.stop()
+            self.stop_own_motion()
         self.following = False
 
     def _plan(self) -> Status:
@@ -286,7 +319,7 @@ class Explore(Skill):
         if res.ok:
             assert res.path is not None
             self.failures = 0
-            r.follow_path(res.path)
+            self.follow(res.path)
             self.following = True
             length = _length(res.path)
             self.feedback_message = f"{res.mode}: {length:.1f} m, gain {res.gain:.0f} m3"
@@ -355,8 +388,9 @@ class Home(Skill):
     arrivals short of home).
     """
 
-    #: Where a path home comes from, in the order they are tried.
-    SOURCES = ("gbplanner2", "navigator", "traversed_path")
+    #: Where a path home comes from, in the order they are tried: the traversed path
+    #: with its loops cut out, then exactly as walked.
+    SOURCES = ("gbplanner2", "navigator", "traversed_path", "traversed_path_exact")
 
     PARAMS = {
         "tolerance_m": Param(float, 1.0, "distance to home that counts as home", exclusive_minimum=0),
@@ -371,15 +405,16 @@ class Home(Skill):
         self.moving = False
         self.first_source = 0
         self.source = 0
+        self.walk: Any = None
 
     def initialise(self) -> None:
-        self.replans, self.moving, self.first_source, self.source = 0, False, 0, 0
+        self.replans, self.moving, self.first_source, self.source, self.walk = 0, False, 0, 0, None
 
     def update(self) -> Status:
         r = self.robot
         if np.linalg.norm(r.position - r.home) <= self.p["tolerance_m"]:
             if self.moving:
-                r.stop()
+                self.stop_own_motion()
             self.moving = False
             self.bb.set(self.k_home, True)
             self.event("home_reached", endurance_s=round(r.endurance_remaining_s, 1))
@@ -411,8 +446,10 @@ class Home(Skill):
                 break
         if path is None or not len(path):
             return self._fail("no path home")
+        if not self.SOURCES[self.source].startswith("traversed_path"):
+            self.walk = None
         path = np.vstack([path, r.home])
-        r.follow_path(path)
+        self.follow(path)
         self.moving = True
         self.bb.set(self.k_mode, "homing")
         length = _length(np.vstack([r.position, path]))
@@ -429,9 +466,18 @@ class Home(Skill):
         if source == "navigator":
             path, _ = navigator(self.ctx, r).path_to_point(r.home, force=True)
             return path
-        from .motion import backtrack_path, max_jump_dz
+        from .motion import TrailWalk, jump_check
 
-        return backtrack_path(r.traversed_path, None, max_jump_dz_m=max_jump_dz(r))
+        trail = r.traversed_path
+        if len(trail) == 0 or np.linalg.norm(trail[0] - r.home) > self.p["tolerance_m"]:
+            return None  # a traversed path that does not start at home does not lead there
+        if source == "traversed_path":
+            self.walk = TrailWalk.plan(trail, None, can_jump=jump_check(r))
+            return self.walk.path
+        if self.walk is not None:
+            # The loop-cut way back was blocked: the rest of it exactly as walked.
+            return self.walk.exact_rest(r.position)
+        return TrailWalk.plan(trail, None, loop_radius_m=0.0).path
 
     def _fail(self, reason: str) -> Status:
         self.feedback_message = reason
@@ -440,9 +486,9 @@ class Home(Skill):
 
     def terminate(self, new_status: Status) -> None:
         if new_status == Status.INVALID and self.moving and self.ctx.robot is not None:
-            self.robot.stop()
+            self.stop_own_motion()
         self.moving = False
 
 
-__all__ = ["PLAN_REASONS", "Explore", "Home", "PlannerService", "gbplanner", "onboard_grid", "parse_bbox",
+__all__ = ["PLAN_REASONS", "Explore", "Home", "PlannerService", "ShrinkingLocalPlanner", "gbplanner", "onboard_grid", "parse_bbox",
            "plan_reason", "robot_config", "sealed_grid", "stable_seed"]

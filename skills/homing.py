@@ -98,7 +98,7 @@ class ReturnHome(Skill):
         path, length = navigator(self.ctx, r).path_to_point(r.home, force=True)
         if path is None:
             path = np.array([r.home])  # the last stretch: straight to the start pose
-        r.follow_path(np.vstack([path, r.home]))
+        self.follow(np.vstack([path, r.home]))
         self.moving = True
         self.feedback_message = f"home is {length:.0f} m away"
         self.event("homing", path_length_m=round(length, 1) if np.isfinite(length) else None)
@@ -106,4 +106,4 @@ class ReturnHome(Skill):
 
     def terminate(self, new_status: Status) -> None:
         if new_status == Status.INVALID and self.ctx.robot is not None:
-            self.robot.stop()
+            self.stop_own_motion()

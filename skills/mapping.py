@@ -45,7 +45,8 @@ class ShareMap(Skill):
 
 
 class MergeMaps(Skill):
-    """Base station: merge every map delta that arrives into the base map.
+    """Base station: merge every map delta that arrives into the base map; log every
+    other message (reports for the supervisor) as a ``base_received`` event.
 
     Reads services ``radio`` and ``map`` of the base station's agent.
     Returns RUNNING (it is a background task).
@@ -56,4 +57,7 @@ class MergeMaps(Skill):
         for msg in radio.receive():
             if msg.kind == MAP_DELTA:
                 base_map.merge(msg.data["flat"], msg.data["values"])
+            else:
+                self.event("base_received", sender=msg.sender, kind=msg.kind, data=msg.data, sent_s=msg.sent_s)
         return Status.RUNNING
+

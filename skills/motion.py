@@ -2,13 +2,14 @@
 (the CERBERUS behaviour tree's "Recovery Homing" and its WiFi-safety back-off)."""
 from __future__ import annotations
 
-from typing import Any
+from dataclasses import dataclass
+from typing import Any, Callable
 
 import numpy as np
 from py_trees.common import Access, Status
 from scipy.spatial import cKDTree
 
-from ..planners.occupancy import OCCUPIED
+from ..planners.occupancy import FREE, OCCUPIED, Grid
 from .base import Param, Skill
 from .gbplanner import gbplanner, onboard_grid
 from .navigation import navigator
@@ -82,7 +83,7 @@ class GoTo(Skill):
                 return self._fail("no_goal", "no goal [x, y, z] given")
         if goal_distance(r, self.goal) <= self.p["tolerance_m"]:
             if self.moving:
-                r.stop()
+                self.stop_own_motion()
             self.moving = False
             self.event("goto_reached", goal=_xyz(self.goal))
             return Status.SUCCESS
@@ -100,7 +101,7 @@ class GoTo(Skill):
 
     def terminate(self, new_status: Status) -> None:
         if new_status == Status.INVALID and self.moving and self.ctx.robot is not None:
-            self.robot.stop()
+            self.stop_own_motion()
         self.moving = False
 
     def _read_goal(self) -> np.ndarray | None:
@@ -131,7 +132,7 @@ class GoTo(Skill):
         self.last_end = end
         if grid.value_at(goal[None])[0] != OCCUPIED and np.linalg.norm(end - goal) > 1e-6:
             path = np.vstack([path, goal])
-        r.follow_path(path)
+        self.follow(path)
         self.moving = True
         length = float(np.linalg.norm(np.diff(np.vstack([r.position, path]), axis=0), axis=1).sum())
         self.bb.set(self.k_length, round(length, 2))
@@ -165,37 +166,38 @@ class GoTo(Skill):
         return Status.FAILURE
 
 
-def max_jump_dz(robot: Robot) -> float:
-    """Largest height change a loop cut of the way back may make: a legged robot's
-    highest step (an aerial robot's: unlimited)."""
+def jump_check(robot: Robot) -> Callable[[np.ndarray, np.ndarray], bool]:
+    """Whether the robot can go straight from one point of its trail to another, on
+    its onboard map: an aerial robot through known free voxels; a legged robot over
+    mapped ground, every point of the segment with rock at most ``body_height_m +
+    max_step_m`` below the body and the ground's height varying by at most
+    ``max_step_m`` (so a loop cut never crosses a trench or a ledge)."""
+    m = robot.onboard_map
+    grid = Grid(m.occupancy, m.origin, m.voxel_size_m)
+    vs = grid.voxel_size_m
     mob = robot.mobility
-    return float("inf") if mob.aerial else float(mob.max_step_m)
+
+    def ok(a: np.ndarray, b: np.ndarray) -> bool:
+        n = int(np.ceil(np.linalg.norm(b - a) / (0.5 * vs))) + 1
+        pts = a + (b - a) * np.linspace(0.0, 1.0, n)[:, None]
+        if mob.aerial:
+            return bool(np.all(grid.value_at(pts) == FREE))
+        if np.any(grid.value_at(pts) == OCCUPIED):
+            return False
+        depth = np.arange(0.0, mob.body_height_m + mob.max_step_m + vs, vs)
+        col = pts[:, None, :] - np.stack([np.zeros_like(depth), np.zeros_like(depth), depth], axis=1)[None]
+        rock = grid.value_at(col.reshape(-1, 3)).reshape(n, len(depth)) == OCCUPIED
+        if not np.all(rock.any(axis=1)):
+            return False
+        ground = pts[:, 2] - depth[rock.argmax(axis=1)]
+        return bool(ground.max() - ground.min() <= mob.max_step_m + vs)
+
+    return ok
 
 
-def backtrack_path(trail: np.ndarray, distance_m: float | None = None, loop_radius_m: float = 0.75,
-                   max_jump_dz_m: float = float("inf")) -> np.ndarray:
-    """The way back along ``trail`` ((N, 3) positions, oldest first), newest first,
-    with loops cut out, at most ``distance_m`` long (None: all the way to its start).
-
-    A loop is cut where the trail passes within ``loop_radius_m`` (and within
-    ``max_jump_dz_m`` of height) of an older point of itself: the way back jumps to
-    the oldest such point, so an earlier back-and-forth (a previous backtrack, a dead
-    end, a loop) is not walked again.
-    """
-    trail = np.asarray(trail, float).reshape(-1, 3)
-    if len(trail) == 0:
-        return trail
-    tree = cKDTree(trail)
-    out = [trail[-1]]
-    i = len(trail) - 1
-    while i > 0:
-        near = np.asarray(tree.query_ball_point(trail[i], loop_radius_m), dtype=np.int64)
-        near = near[np.abs(trail[near, 2] - trail[i, 2]) <= max_jump_dz_m]
-        j = int(near.min()) if len(near) else i - 1
-        i = j if j < i - 1 else i - 1
-        out.append(trail[i])
-    path = np.asarray(out)
-    if distance_m is None:
+def _cut(path: np.ndarray, distance_m: float | None) -> np.ndarray:
+    """The first ``distance_m`` of ``path`` (all of it for None)."""
+    if distance_m is None or len(path) < 2:
         return path
     seg = np.linalg.norm(np.diff(path, axis=0), axis=1)
     cum = np.concatenate([[0.0], np.cumsum(seg)])
@@ -204,6 +206,72 @@ def backtrack_path(trail: np.ndarray, distance_m: float | None = None, loop_radi
     k = int(np.searchsorted(cum, distance_m, side="right"))  # path[k] is the first beyond
     t = (distance_m - cum[k - 1]) / max(seg[k - 1], 1e-12)
     return np.vstack([path[:k], path[k - 1] + t * (path[k] - path[k - 1])])
+
+
+@dataclass
+class TrailWalk:
+    """A way back along a snapshot of the traversed path: ``indices`` into ``trail``
+    (oldest first), newest first, loops cut out; ``path`` is at most ``distance_m``."""
+
+    trail: np.ndarray
+    indices: np.ndarray
+    distance_m: float | None = None
+
+    @classmethod
+    def plan(cls, trail: np.ndarray, distance_m: float | None = None, loop_radius_m: float = 0.75,
+             can_jump: Callable[[np.ndarray, np.ndarray], bool] | None = None) -> TrailWalk:
+        """Walk back from the newest point; where the trail passes within
+        ``loop_radius_m`` of an older point of itself (and ``can_jump`` allows going
+        straight there), jump to the oldest such point, so an earlier back-and-forth
+        (a previous backtrack, a dead end, a loop) is not walked again."""
+        trail = np.asarray(trail, float).reshape(-1, 3)
+        if len(trail) == 0:
+            return cls(trail, np.zeros(0, np.int64), distance_m)
+        tree = cKDTree(trail) if loop_radius_m > 0 else None
+        out = [len(trail) - 1]
+        i = len(trail) - 1
+        while i > 0:
+            nxt = i - 1
+            if tree is not None:
+                for j in sorted(tree.query_ball_point(trail[i], loop_radius_m)):
+                    if j >= i - 1:
+                        break
+                    if can_jump is None or can_jump(trail[i], trail[j]):
+                        nxt = j
+                        break
+            i = nxt
+            out.append(i)
+        return cls(trail, np.asarray(out, np.int64), distance_m)
+
+    @property
+    def path(self) -> np.ndarray:
+        return _cut(self.trail[self.indices], self.distance_m)
+
+    def exact_rest(self, position: np.ndarray, covered_m: float = 0.0) -> np.ndarray:
+        """The rest of the way from ``position`` exactly as walked, no loop cut: back
+        to the start of the leg of this walk nearest to ``position``, then along every
+        older point of the trail (at most ``distance_m - covered_m``)."""
+        pts = self.trail[self.indices]
+        if len(pts) == 0:
+            return pts
+        k = 0
+        if len(pts) > 1:
+            a, b = pts[:-1], pts[1:]
+            ab = b - a
+            t = np.clip(np.einsum("ij,ij->i", position - a, ab) / np.maximum(np.einsum("ij,ij->i", ab, ab), 1e-12),
+                        0.0, 1.0)
+            k = int(np.argmin(np.linalg.norm(a + t[:, None] * ab - position, axis=1)))
+        rest = self.trail[self.indices[k]::-1]
+        left = None if self.distance_m is None else max(self.distance_m - covered_m, 0.0)
+        return _cut(np.vstack([position, rest]), left)[1:]
+
+
+def backtrack_path(trail: np.ndarray, distance_m: float | None = None, loop_radius_m: float = 0.75,
+                   can_jump: Callable[[np.ndarray, np.ndarray], bool] | None = None) -> np.ndarray:
+    """The way back along ``trail`` ((N, 3) positions, oldest first), newest first,
+    with loops cut out (see :meth:`TrailWalk.plan`), at most ``distance_m`` long (None:
+    all the way to its start)."""
+    return TrailWalk.plan(trail, distance_m, loop_radius_m, can_jump).path
 
 
 class Backtrack(Skill):
@@ -234,10 +302,12 @@ class Backtrack(Skill):
         self.k_until = self.key(self.p["until_key"], Access.READ) if self.p["until_key"] else None
         self.k_done = self.key("backtracked_m")
         self.path: np.ndarray | None = None
+        self.walk: TrailWalk | None = None
         self.start_distance_m = 0.0
+        self.exact = False
 
     def initialise(self) -> None:
-        self.path = None
+        self.path, self.walk, self.exact = None, None, False
 
     def update(self) -> Status:
         r = self.robot
@@ -250,47 +320,58 @@ class Backtrack(Skill):
         if status == PathStatus.FOLLOWING:
             return Status.RUNNING
         if status == PathStatus.BLOCKED:
-            return self._done(Status.FAILURE, f"way back blocked: {getattr(r, 'blocked_reason', '')}")
+            reason = getattr(r, "blocked_reason", "")
+            if not self.exact:
+                # A loop cut did not work out: the rest of the way exactly as walked.
+                self.event("backtrack_blocked", reason=reason)
+                return self._start(exact=True)
+            return self._done(Status.FAILURE, f"way back blocked: {reason}")
         if self.k_until is not None:
             return self._done(Status.FAILURE, "the way back ended and the condition still does not hold")
         return self._done(Status.SUCCESS, "back")
 
     def terminate(self, new_status: Status) -> None:
         if new_status == Status.INVALID and self.path is not None and self.ctx.robot is not None:
-            self.robot.stop()
+            self.stop_own_motion()
         self.path = None
 
-    def _start(self) -> Status:
+    def _start(self, exact: bool = False) -> Status:
         r = self.robot
-        path = backtrack_path(r.traversed_path, self.p["distance_m"], self.p["loop_radius_m"], max_jump_dz(r))
+        if exact and self.walk is not None:
+            self.exact = True
+            path = self.walk.exact_rest(r.position, r.distance_m - self.start_distance_m)
+        else:
+            self.start_distance_m = r.distance_m
+            self.walk = TrailWalk.plan(r.traversed_path, self.p["distance_m"], self.p["loop_radius_m"], jump_check(r))
+            path = self.walk.path
         # Drop the points the robot is already at.
         k = 0
         while k < len(path) and np.linalg.norm(path[k] - r.position) < 1e-6:
             k += 1
         path = path[k:]
         if len(path) == 0:
-            self.feedback_message = "no traversed path to go back along"
-            self.event("backtrack_failed", reason=self.feedback_message)
-            return Status.FAILURE
+            if exact and self.k_until is None:
+                return self._done(Status.SUCCESS, "back")
+            return self._done(Status.FAILURE, "no traversed path to go back along")
         self.path = path
-        self.start_distance_m = r.distance_m
-        self.bb.set(self.k_done, 0.0)
-        r.follow_path(path)
+        if not exact:
+            self.bb.set(self.k_done, 0.0)
+        self.follow(path)
         length = float(np.linalg.norm(np.diff(np.vstack([r.position, path]), axis=0), axis=1).sum())
         self.feedback_message = f"backtracking {length:.1f} m"
-        self.event("backtrack", trigger=True, length_m=round(length, 1), to=_xyz(path[-1]),
-                   until=self.p["until_key"])
+        self.event("backtrack", trigger=not exact, length_m=round(length, 1), to=_xyz(path[-1]),
+                   until=self.p["until_key"], exact=exact)
         return Status.RUNNING
 
     def _done(self, status: Status, reason: str) -> Status:
         r = self.robot
         if self.path is not None and r.path_status == PathStatus.FOLLOWING:
-            r.stop()
+            self.stop_own_motion()
         self.feedback_message = reason
         self.event("backtrack_done" if status == Status.SUCCESS else "backtrack_failed", reason=reason,
-                   backtracked_m=round(r.distance_m - self.start_distance_m, 2) if self.path is not None else 0.0)
-        self.path = None
+                   backtracked_m=round(r.distance_m - self.start_distance_m, 2))
+        self.path, self.walk = None, None
         return status
 
 
-__all__ = ["GOTO_FAILURES", "Backtrack", "GoTo", "backtrack_path", "goal_distance", "max_jump_dz"]
+__all__ = ["GOTO_FAILURES", "Backtrack", "GoTo", "TrailWalk", "backtrack_path", "goal_distance", "jump_check"]

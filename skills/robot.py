@@ -104,6 +104,66 @@ class BreadcrumbDrop(Protocol):
     error: str
 
 
+class PayloadSpecView(Protocol):
+    """The limits of a pan-tilt-zoom payload that skills read."""
+
+    @property
+    def yaw_limits_deg(self) -> tuple[float, float]: ...
+
+    @property
+    def pitch_limits_deg(self) -> tuple[float, float]: ...
+
+    @property
+    def range_m(self) -> float:
+        """A point farther than this from the camera is not seen."""
+
+    @property
+    def joint_grid_deg(self) -> float:
+        """Resolution of the candidate scan points in joint space (3° in the paper)."""
+
+    @property
+    def max_zoom(self) -> float: ...
+
+
+class Payload(Protocol):
+    """A pan-tilt-zoom inspection camera on the robot's body (the ANYmal's inspection
+    payload). Angles are in degrees: yaw turns about the body's z axis (positive to the
+    left), pitch raises the camera. A body pose is ``(x, y, z, yaw_rad)`` or a (4, 4)
+    transform body -> world."""
+
+    @property
+    def spec(self) -> PayloadSpecView: ...
+
+    @property
+    def yaw_deg(self) -> float: ...
+
+    @property
+    def pitch_deg(self) -> float: ...
+
+    @property
+    def zoom(self) -> float: ...
+
+    def view_directions(self, joint_grid_deg: float | None = None) -> np.ndarray:
+        """The candidate scan points (K, 2) = (yaw, pitch) on the joint-space grid
+        (1170 at 3°)."""
+
+    def camera_position(self, body_pose: np.ndarray) -> np.ndarray:
+        """World position (3,) of the camera's optical centre (it does not depend on the joints)."""
+
+    def in_view(self, points: np.ndarray, body_pose: np.ndarray, candidates: np.ndarray,
+                zoom: float = 1.0) -> np.ndarray:
+        """(N, K) bool: which points lie inside the field of view of each (yaw, pitch)
+        candidate at ``zoom``, ignoring range and occlusion (pure geometry)."""
+
+    def point_at(self, yaw_deg: float, pitch_deg: float, zoom: float | None = None) -> float:
+        """Command the joints (and the zoom); returns the slew time in seconds.
+        ValueError outside the joint limits or the zoom range."""
+
+    def zoom_for_distance(self, distance_m: float) -> float:
+        """The zoom that keeps an object at ``distance_m`` the size it has at the
+        reference distance, within 1..max_zoom."""
+
+
 class Robot(Protocol):
     """A robot as skills see it."""
 
@@ -156,6 +216,12 @@ class Robot(Protocol):
 
     def stop(self) -> None: ...
 
+    @property
+    def command_id(self) -> int:
+        """Counts motion commands (``follow_path`` and ``stop``), so a behaviour can
+        tell whether the robot still follows its command."""
+
+
     def reset_local_map(self, radius_m: float) -> None:
         """Forget the onboard map within ``radius_m`` of the robot; the next scans map
         it again (the paper's reset of the elevation map after odometry artifacts)."""
@@ -170,3 +236,13 @@ class Robot(Protocol):
 
     def deploy_breadcrumb(self) -> BreadcrumbDrop:
         """Drop a breadcrumb where the robot stands; a refusal is a result, not an exception."""
+
+    @property
+    def remaining_path(self) -> np.ndarray:
+        """(M, 3) waypoints of the path being followed that the robot has not reached
+        yet, the next one first; (0, 3) when it follows none. A behaviour that pauses
+        another's motion re-issues them to resume it on the same path."""
+
+    @property
+    def payload(self) -> Payload | None:
+        """The pan-tilt-zoom inspection camera; None when the robot carries none."""

@@ -1,0 +1,75 @@
+"""The blocks of the CERBERUS ANYmal tree (Figure 13), each in its own scenario: the
+block fires when its situation arises and the mission still ends well."""
+import numpy as np
+import pytest
+
+from delve import SCENARIOS_DIR
+
+from .conftest import run_scenario
+
+
+def events(mission, name, **match):
+    return [e for e in mission.state.events if e["event"] == name and all(e.get(k) == v for k, v in match.items())]
+
+
+def ends_well(mission):
+    """Every robot's tree succeeded and every robot is home with endurance left."""
+    assert mission.succeeded
+    for robot in mission.robots.values():
+        assert np.linalg.norm(robot.position - robot.home) <= 1.5
+        assert robot.endurance_remaining_s > 0
+
+
+def test_watchdog_recovers_a_robot_whose_feet_are_stuck():
+    mission, _ = run_scenario(SCENARIOS_DIR / "cerberus_watchdog.yaml")
+    (fault,) = events(mission, "fault", kind="stuck")
+    # It fires after stuck_time_s without motion, while the feet are still stuck.
+    fired = [e for e in events(mission, "watchdog") if fault["t"] + 19 <= e["t"] <= fault["t"] + 60]
+    assert fired, "the watchdog did not fire while the robot was stuck"
+
+    recovery = [e for e in events(mission, "backtrack") if e["t"] >= fired[0]["t"] and e["node"] == "Recovery Homing"]
+    assert recovery
+    assert [e for e in events(mission, "gbplanner_path") if e["t"] > fault["t"] + 60], "exploration did not resume"
+    ends_well(mission)
+
+
+def test_wifi_safety_backs_off_until_the_base_answers_then_resumes():
+    mission, _ = run_scenario(SCENARIOS_DIR / "cerberus_wifi.yaml")
+    backoff = [e for e in events(mission, "backtrack") if e["node"] == "Backtrack until connected"]
+    assert backoff, "WiFi safety never fired"
+    reconnected = [e for e in events(mission, "backtrack_done") if e["node"] == "Backtrack until connected"]
+    assert reconnected and reconnected[0]["reason"] == "condition holds"
+    resumed = [e for e in events(mission, "gbplanner_path") if e["t"] > reconnected[0]["t"]]
+    assert resumed, "exploration did not resume after reconnecting"
+    ends_well(mission)
+
+
+def test_homing_timer_brings_the_robot_home_when_the_budget_ends():
+    mission, _ = run_scenario(SCENARIOS_DIR / "cerberus_budget.yaml")
+    (command,) = events(mission, "operator_command", command="explore")
+    (timer,) = events(mission, "homing_timer")
+    assert timer["t"] == pytest.approx(command["t"] + 600, abs=1.0)
+    assert not [e for e in events(mission, "backtrack") if e["node"] == "Backtrack until connected"], \
+        "WiFi safety must stay quiet while a time budget is set"
+    homing = events(mission, "homing")
+    assert homing and homing[0]["t"] >= timer["t"]
+    ends_well(mission)
+
+
+def test_unreachable_goal_is_reported_to_the_supervisor():
+    mission, _ = run_scenario(SCENARIOS_DIR / "cerberus_goal_unreachable.yaml")
+    failed = events(mission, "goto_failed")
+    assert failed and failed[0]["goto_failure"] == "no_path"
+    assert events(mission, "supervisor_notified")
+    received = events(mission, "base_received", kind="goal_unreachable")
+    assert received and received[0]["data"]["goal"] == [0, 0, 30]
+    ends_well(mission)
+
+
+def test_invalid_start_pose_resets_the_local_map_and_retries():
+    mission, _ = run_scenario(SCENARIOS_DIR / "cerberus_map_reset.yaml")
+    (fault,) = events(mission, "fault", kind="map_artifact")
+    resets = [e for e in events(mission, "local_map_reset") if e["t"] >= fault["t"]]
+    assert resets and resets[0]["t"] <= fault["t"] + 30
+    assert [e for e in events(mission, "gbplanner_path") if e["t"] > resets[0]["t"]], "exploration did not resume"
+    ends_well(mission)

@@ -1,0 +1,322 @@
+"""delve.skills.gbplanner: Explore and Home on a small fake robot over synthetic maps."""
+from __future__ import annotations
+
+import zlib
+
+import numpy as np
+import py_trees
+import pytest
+from delve.executive.errors import DelveError
+from delve.executive.tree_loader import build_tree, check_context
+from delve.planners.gbplanner2 import synthetic as syn
+from delve.planners.occupancy import FREE, OCCUPIED, UNKNOWN, Grid
+from delve.skills.gbplanner import (SERVICE, Explore, Home, ShrinkingLocalPlanner, gbplanner, parse_bbox,
+                                    robot_config, sealed_grid, stable_seed)
+from py_trees.common import Status
+
+from .test_motion import FakeRobot, body, events, make_ctx, run
+
+SMALL = {"max_vertices": 150, "planner": {"num_edges_max": 2500}}
+
+
+@pytest.fixture(autouse=True)
+def clean_blackboard():
+    py_trees.blackboard.Blackboard.clear()
+    yield
+    py_trees.blackboard.Blackboard.clear()
+
+
+@pytest.fixture(scope="module")
+def half_mapped():
+    """A 50 m tunnel along x mapped for its first 25 m."""
+    return syn.straight_tunnel(length_m=50, mapped_to_m=25)
+
+
+@pytest.fixture(scope="module")
+def mapped():
+    """A 24 m tunnel, all mapped: nothing left to explore."""
+    return syn.straight_tunnel(length_m=24)
+
+
+def explore(ctx, **params) -> Explore:
+    return Explore(name="Explore", ctx=ctx, **{**SMALL, **params})
+
+
+def bb(key: str):
+    return py_trees.blackboard.Blackboard.get(f"/r1/{key}")
+
+
+# --------------------------------------------------------------------- configuration
+
+
+def test_robot_config_takes_the_platform_preset_and_the_robot_limits(half_mapped):
+    grid, a, _ = half_mapped
+    legged = FakeRobot(grid, body(a, 3.0), endurance_s=1200.0)
+    cfg = robot_config(legged)
+    assert cfg.robot_type == "legged" and cfg.num_vertices_max == 1000 and cfg.sensor_fov_vertical_deg == 30.0
+    assert cfg.max_inclination_deg == 35.0 and cfg.endurance_s == 1200.0 and cfg.clustering_radius_m == 0.0
+    aerial = FakeRobot(grid, body(a, 3.0), platform="aerial")
+    cfg = robot_config(aerial, {"num_vertices_max": 300})
+    assert cfg.robot_type == "aerial" and cfg.num_vertices_max == 300
+    assert cfg.clustering_radius_m == 1.0 and cfg.sensor_fov_vertical_deg == 90.0
+
+
+def test_one_planner_per_agent_seeded_from_the_agent_name(half_mapped):
+    grid, a, _ = half_mapped
+    robot = FakeRobot(grid, body(a, 3.0))
+    ctx = make_ctx(robot)
+    svc = gbplanner(ctx, robot, {"num_vertices_max": 150})
+    assert gbplanner(ctx, robot) is svc and ctx.services[SERVICE] is svc
+    assert isinstance(svc.planner.local_planner, ShrinkingLocalPlanner)
+    assert stable_seed(3, "anymal") == [3, zlib.crc32(b"anymal")]
+    # Other overrides reconfigure the planner and keep its global graph.
+    graph = svc.planner.global_planner.graph
+    gbplanner(ctx, robot, {"num_vertices_max": 120})
+    assert svc.planner.config.num_vertices_max == 120 and svc.planner.global_planner.graph is graph
+
+
+def test_the_same_seed_and_agent_give_the_same_plan(half_mapped):
+    grid, a, _ = half_mapped
+    paths = []
+    for name in ("r1", "r1"):
+        py_trees.blackboard.Blackboard.clear()
+        robot = FakeRobot(grid, body(a, 8.0))
+        node = explore(make_ctx(robot, name), seed=4)
+        node.tick_once()
+        paths.append(robot.paths[0])
+    assert np.array_equal(paths[0], paths[1])
+
+
+def test_bad_planner_overrides_fail_when_the_tree_is_built():
+    with pytest.raises(DelveError, match="unknown GBPlannerConfig parameter"):
+        build_tree({"type": "Explore", "planner": {"num_vertice_max": 10}}, check_context())
+    with pytest.raises(DelveError, match="max_vertices"):
+        build_tree({"type": "Explore", "max_vertices": 1}, check_context())
+
+
+def test_parse_bbox():
+    lo, hi = parse_bbox({"min": [0, 0, 0], "max": [10, -5, 3]})
+    assert np.allclose(lo, [0, -5, 0]) and np.allclose(hi, [10, 0, 3])
+    lo, hi = parse_bbox([[1, 2, 3], [4, 5, 6]])
+    assert np.allclose(lo, [1, 2, 3]) and np.allclose(hi, [4, 5, 6])
+    assert parse_bbox(None) is None
+    with pytest.raises(ValueError):
+        parse_bbox({"min": [0, 0]})
+    with pytest.raises(ValueError):
+        parse_bbox([[0, 0, 0]])
+
+
+def test_sealed_grid_closes_one_voxel_gaps_in_the_rock_surface():
+    occ = np.full((5, 5, 5), UNKNOWN, np.int8)
+    occ[1:4, 1:4, 1:4] = FREE
+    occ[0, :, :] = OCCUPIED
+    grid = Grid(occ, np.zeros(3), 0.2)
+    out = sealed_grid(grid)
+    assert out.occupancy[1, 0, 0] == OCCUPIED  # unknown, touches rock
+    assert out.occupancy[4, 4, 4] == UNKNOWN   # unknown, no rock beside it
+    assert np.array_equal(out.occupancy == FREE, occ == FREE)
+    assert grid.occupancy[1, 0, 0] == UNKNOWN  # the map itself is untouched
+
+
+# --------------------------------------------------------------------------- Explore
+
+
+def test_explore_heads_into_the_unknown_and_writes_the_blackboard(half_mapped):
+    grid, a, _ = half_mapped
+    robot = FakeRobot(grid, body(a, 8.0))
+    ctx = make_ctx(robot)
+    node = explore(ctx)
+    node.tick_once()
+    assert node.status == Status.RUNNING
+    (path,) = robot.paths
+    assert path[-1][0] > robot.position[0] + 3.0
+    assert bb("planner_mode") == "explore" and bb("last_plan_reason") == "ok"
+    assert bb("exploration_complete") is False and bb("homing_due") is False
+    assert events(ctx, "gbplanner_path")[0]["mode"] == "explore"
+    node.tick_once()  # still following: no new plan
+    assert len(robot.paths) == 1
+    robot.step(100.0)  # arrived: the next tick plans again
+    node.tick_once()
+    assert len(robot.paths) == 2
+
+
+def test_explore_succeeds_when_nothing_is_left(mapped):
+    grid, a, _ = mapped
+    robot = FakeRobot(grid, body(a, 6.0))
+    ctx = make_ctx(robot)
+    node = explore(ctx)
+    assert run(node, ctx, robot, ticks=60, dt_s=2.0) == Status.SUCCESS
+    assert bb("exploration_complete") is True and bb("last_plan_reason") == "exploration_complete"
+    assert events(ctx, "exploration_complete")
+
+
+def test_explore_hands_over_to_homing_when_the_endurance_is_short(half_mapped):
+    grid, a, _ = half_mapped
+    robot = FakeRobot(grid, body(a, 14.0), home=body(a, 2.0), endurance_s=40.0)
+    ctx = make_ctx(robot)
+    node = explore(ctx)
+    node.tick_once()
+    assert node.status == Status.SUCCESS
+    assert bb("homing_due") is True and bb("planner_mode") == "homing" and bb("last_plan_reason") == "homing_due"
+    assert events(ctx, "planner_homing")[0]["trigger"] is True
+    # Without the planner's endurance check it keeps exploring.
+    py_trees.blackboard.Blackboard.clear()
+    ctx = make_ctx(robot)
+    node = explore(ctx, endurance_homing=False)
+    node.tick_once()
+    assert node.status == Status.RUNNING
+
+
+def test_explore_fails_at_once_on_an_invalid_start(half_mapped):
+    grid, a, _ = half_mapped
+    robot = FakeRobot(grid, body(a, 8.0, 1.9))  # the robot box overlaps the tunnel wall
+    ctx = make_ctx(robot)
+    node = explore(ctx)
+    node.tick_once()
+    assert node.status == Status.FAILURE
+    assert bb("last_plan_reason") == "invalid_start" and bb("planner_mode") == "none"
+    assert events(ctx, "explore_failed")[0]["reason"] == "invalid_start"
+
+
+def test_a_planner_error_is_a_failure_with_its_reason(half_mapped):
+    grid, a, _ = half_mapped
+    robot = FakeRobot(grid, body(a, 8.0))
+    ctx = make_ctx(robot)
+    node = explore(ctx)
+    svc = gbplanner(ctx, robot, node.overrides)
+
+    def broken(*args, **kwargs):
+        raise RuntimeError("the map is corrupt")
+
+    svc.planner.plan = broken
+    node.tick_once()
+    assert node.status == Status.FAILURE
+    assert bb("last_plan_reason") == "error"
+    (failed,) = events(ctx, "explore_failed")
+    assert "the map is corrupt" in failed["detail"]
+
+
+def test_explore_retries_a_failed_iteration_then_fails(half_mapped):
+    grid, a, _ = half_mapped
+    robot = FakeRobot(grid, body(a, 8.0))
+    ctx = make_ctx(robot)
+    node = explore(ctx, max_failed_plans=2, retry_period_s=5.0)
+    svc = gbplanner(ctx, robot, node.overrides)
+    from delve.planners.gbplanner2 import PlanResult
+
+    svc.planner.plan = lambda *args, **kwargs: PlanResult(None, "none", reason="local planner: no way on")
+    node.tick_once()
+    assert node.status == Status.RUNNING and bb("last_plan_reason") == "no_path"
+    ctx.clock.now_s = 2.0
+    node.tick_once()
+    assert node.status == Status.RUNNING and len(events(ctx, "plan_failed")) == 1  # waiting
+    ctx.clock.now_s = 5.0
+    node.tick_once()
+    assert node.status == Status.FAILURE and len(events(ctx, "plan_failed")) == 2
+
+
+def test_explore_stays_inside_the_exploration_box(half_mapped):
+    grid, a, _ = half_mapped
+    robot = FakeRobot(grid, body(a, 12.0))
+    ctx = make_ctx(robot)
+    box = {"min": (a + [-5.0, -5.0, -1.0]).tolist(), "max": (a + [15.0, 5.0, 4.0]).tolist()}
+    py_trees.blackboard.Blackboard.set("/r1/exploration_bbox", box)
+    node = explore(ctx)
+    for _ in range(4):
+        node.tick_once()
+        robot.step(100.0)
+    assert robot.paths
+    for path in robot.paths:
+        assert path[:, 0].max() <= a[0] + 15.0 + 0.6  # vertices in the box; improvement moves them <= 0.5 m
+
+
+def test_relocate_goes_to_the_best_frontier_first(half_mapped):
+    grid, a, _ = half_mapped
+    robot = FakeRobot(grid, body(a, 8.0))
+    ctx = make_ctx(robot)
+    node = explore(ctx)
+    node.tick_once()
+    robot.step(100.0)
+    node.stop(Status.INVALID)
+    frontiers = gbplanner(ctx, robot).planner.global_planner.frontiers
+    assert frontiers
+    relocating = explore(ctx, relocate=True)
+    relocating.tick_once()
+    assert bb("planner_mode") == "reposition" and bb("last_plan_reason") == "reposition"
+
+
+def test_shrinking_local_planner_refills_a_graph_starved_box(monkeypatch):
+    """A 2 m wide tunnel in a wide, mostly rock and unknown local box: graph building
+    stops after its first batch of samples, and the smaller box fills with vertices."""
+    import delve.planners.gbplanner2.local_planner as lp
+    from delve.planners.gbplanner2 import LocalBound
+
+    grid, a, _ = syn.straight_tunnel(length_m=40, width_m=2.0)
+    p = body(a, 10.0)
+    cfg = robot_config(FakeRobot(grid, p)).replace(num_vertices_max=150, num_edges_max=2500)
+    huge = LocalBound(p, np.eye(3), np.array([17.5, 17.5, 8.0]))
+    monkeypatch.setattr(lp, "adaptive_local_bound", lambda *args, **kwargs: huge)
+    starved = lp.LocalPlanner(cfg).plan(grid, p, np.random.default_rng(0))
+    assert starved.graph.num_vertices < ShrinkingLocalPlanner.min_vertices
+    res = ShrinkingLocalPlanner(cfg).plan(grid, p, np.random.default_rng(0))
+    assert res.graph.num_vertices >= ShrinkingLocalPlanner.min_vertices
+    assert np.all(res.graph.bound.half_extents_m < huge.half_extents_m)
+
+
+# ------------------------------------------------------------------------------ Home
+
+
+def test_home_follows_the_global_graph_home(half_mapped):
+    grid, a, _ = half_mapped
+    home = body(a, 2.0)
+    robot = FakeRobot(grid, home, home=home)
+    ctx = make_ctx(robot)
+    node = explore(ctx)
+    for _ in range(3):  # explore a little: the global graph grows from home
+        node.tick_once()
+        robot.step(100.0)
+    assert np.linalg.norm(robot.position - home) > 3.0
+    homing = Home(name="Home", ctx=ctx)
+    assert run(homing, ctx, robot) == Status.SUCCESS
+    assert np.linalg.norm(robot.position - home) <= 1.0
+    assert bb("returned_home") is True
+    assert events(ctx, "homing")[0]["source"] == "gbplanner2"
+    assert events(ctx, "home_reached")
+
+
+def test_home_falls_back_to_the_navigation_graph(half_mapped):
+    grid, a, _ = half_mapped
+    home = body(a, 2.0)
+    robot = FakeRobot(grid, body(a, 20.0), home=home)  # the global graph knows only home, 18 m away
+    ctx = make_ctx(robot)
+    homing = Home(name="Home", ctx=ctx)
+    assert run(homing, ctx, robot) == Status.SUCCESS
+    assert events(ctx, "homing")[0]["source"] == "navigator"
+
+
+def test_home_falls_back_to_the_traversed_path_when_blocked(half_mapped):
+    grid, a, _ = half_mapped
+    home = body(a, 2.0)
+    trail = [body(a, x) for x in np.arange(2.0, 20.01, 0.5)]
+    robot = FakeRobot(grid, trail[-1], home=home, trail=trail)
+    ctx = make_ctx(robot)
+    homing = Home(name="Home", ctx=ctx)
+    homing.tick_once()  # the global graph knows only home, 18 m away: the navigation graph's path
+    robot.block_at, robot.block_radius_m = robot.position + np.array([-0.5, 0.0, 0.0]), 0.1
+    robot.step(1.0)
+    robot.block_at = None
+    assert robot.path_status.value == "blocked"
+    assert run(homing, ctx, robot) == Status.SUCCESS
+    assert [e["source"] for e in events(ctx, "homing")] == ["navigator", "traversed_path"]
+    assert events(ctx, "homing_path_blocked")[0]["source"] == "navigator"
+
+
+def test_home_fails_without_any_path_home():
+    grid, a, _ = syn.straight_tunnel(length_m=30)
+    # Home far above the map, and a traversed path that does not start there.
+    robot = FakeRobot(grid, body(a, 15.0), home=body(a, 2.0) + np.array([0.0, 0.0, 30.0]))
+    ctx = make_ctx(robot)
+    homing = Home(name="Home", ctx=ctx)
+    homing.tick_once()
+    assert homing.status == Status.FAILURE
+    assert events(ctx, "homing_failed")[0]["reason"] == "no path home"

@@ -1,0 +1,363 @@
+"""delve.skills.motion: GoTo and Backtrack, on a small fake robot over a synthetic map."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import py_trees
+import pytest
+from delve.planners.gbplanner2 import synthetic as syn
+from delve.planners.occupancy import FREE, OCCUPIED, UNKNOWN, Grid
+from delve.skills.base import AgentContext
+from delve.skills.motion import Backtrack, GoTo, TrailWalk, backtrack_path, jump_check
+from delve.skills.robot import PathStatus
+from py_trees.common import Status
+
+
+class Clock:
+    def __init__(self) -> None:
+        self.now_s = 0.0
+
+
+@dataclass
+class FakeMobility:
+    aerial: bool = False
+    speed_mps: float = 1.0
+    body_height_m: float = 0.5
+    radius_m: float = 0.4
+    max_inclination_deg: float = 35.0
+    max_step_m: float = 0.3
+
+
+class FakeMap:
+    """A fixed onboard map."""
+
+    def __init__(self, grid: Grid):
+        self.occupancy, self.origin, self.voxel_size_m, self.version = grid.occupancy, grid.origin, grid.voxel_size_m, 1
+
+    def free_voxels(self) -> np.ndarray:
+        return np.flatnonzero(self.occupancy.reshape(-1) == FREE)
+
+    def take_changes(self) -> tuple[np.ndarray, np.ndarray]:
+        return np.zeros(0, np.int64), np.zeros(0, np.int8)
+
+
+class FakeRobot:
+    """Follows paths in straight lines at its speed when :meth:`step` is called; a path
+    is BLOCKED where it first comes within ``block_radius_m`` of ``block_at``."""
+
+    def __init__(self, grid: Grid, position, home=None, platform: str = "legged", trail=None, endurance_s=3000.0):
+        self.name = "r1"
+        self.platform = platform
+        self.mobility = FakeMobility(aerial=platform == "aerial")
+        self.onboard_map = FakeMap(grid)
+        self._pos = np.asarray(position, float)
+        self.home = np.asarray(home if home is not None else position, float)
+        self.yaw_rad = 0.0
+        self.view_up_deg = 15.0
+        self.endurance_remaining_s = endurance_s
+        self.distance_m = 0.0
+        self.trail = [np.asarray(p, float) for p in (trail if trail is not None else [position])]
+        self.path: np.ndarray | None = None
+        self.path_status = PathStatus.IDLE
+        self.paths: list[np.ndarray] = []
+        self.stops = 0
+        self.block_at: np.ndarray | None = None
+        self.block_radius_m = 0.3
+        self.blocked_reason = ""
+
+    @property
+    def position(self) -> np.ndarray:
+        return self._pos.copy()
+
+    @property
+    def traversed_path(self) -> np.ndarray:
+        return np.asarray(self.trail)
+
+    @property
+    def command_id(self) -> int:
+        return len(self.paths) + self.stops
+
+    def follow_path(self, path) -> None:
+        self.path = np.asarray(path, float).reshape(-1, 3)
+
+        self.paths.append(self.path.copy())
+        self.path_status = PathStatus.FOLLOWING
+
+    def stop(self) -> None:
+        self.stops += 1
+        self.path = None
+        if self.path_status == PathStatus.FOLLOWING:
+            self.path_status = PathStatus.IDLE
+
+    def step(self, dt_s: float = 1.0) -> None:
+        if self.path_status != PathStatus.FOLLOWING or self.path is None:
+            return
+        budget = self.mobility.speed_mps * dt_s
+        while budget > 1e-9 and len(self.path):
+            target = self.path[0]
+            d = float(np.linalg.norm(target - self._pos))
+            move = min(budget, d)
+            new = self._pos + (target - self._pos) * (move / d) if d > 1e-9 else target.copy()
+            if self.block_at is not None and np.linalg.norm(new - self.block_at) < self.block_radius_m:
+                self.path, self.path_status, self.blocked_reason = None, PathStatus.BLOCKED, "rock in the way"
+                return
+            self.distance_m += float(np.linalg.norm(new - self._pos))
+            self._pos = new
+            budget -= move
+            if np.linalg.norm(self.trail[-1] - self._pos) >= 0.5:
+                self.trail.append(self._pos.copy())
+            if d - move < 1e-9:
+                self.path = self.path[1:]
+        if self.path is not None and len(self.path) == 0:
+            self.path, self.path_status = None, PathStatus.ARRIVED
+
+
+def make_ctx(robot, name: str = "r1") -> AgentContext:
+    events: list[tuple[str, dict]] = []
+    ctx = AgentContext(name=name, namespace=f"/{name}", clock=Clock(),
+                       log=lambda event, **fields: events.append((event, fields)), robot=robot)
+    ctx.events = events  # type: ignore[attr-defined]
+    return ctx
+
+
+def run(node, ctx, robot, ticks: int = 200, dt_s: float = 1.0) -> Status:
+    """Tick ``node`` and step the robot until the node is done (or ``ticks`` ran out)."""
+    for _ in range(ticks):
+        node.tick_once()
+        if node.status != Status.RUNNING:
+            return node.status
+        robot.step(dt_s)
+        ctx.clock.now_s += dt_s
+    return node.status
+
+
+def events(ctx, kind: str) -> list[dict]:
+    return [f for e, f in ctx.events if e == kind]
+
+
+@pytest.fixture(autouse=True)
+def clean_blackboard():
+    py_trees.blackboard.Blackboard.clear()
+    yield
+    py_trees.blackboard.Blackboard.clear()
+
+
+@pytest.fixture(scope="module")
+def tunnel():
+    """A 30 m tunnel along x, mapped all along; floor at z = 1 m; start and end floor centres."""
+    return syn.straight_tunnel(length_m=30)
+
+
+def body(p, dx=0.0, dy=0.0):
+    return np.asarray(p, float) + np.array([dx, dy, 0.5])
+
+
+# ----------------------------------------------------------------------------- GoTo
+
+
+def test_goto_reaches_a_goal_given_as_a_param(tunnel):
+    grid, a, _ = tunnel
+    robot = FakeRobot(grid, body(a, 3.0))
+    ctx = make_ctx(robot)
+    goal = body(a, 15.0)
+    node = GoTo(name="Go", ctx=ctx, goal=goal.tolist(), tolerance_m=0.5)
+    assert run(node, ctx, robot) == Status.SUCCESS
+    assert np.linalg.norm(robot.position - goal) <= 0.5
+    assert node.get(node.k_failure) is None
+    assert events(ctx, "goto")[0]["source"] == "navigator"
+    assert events(ctx, "goto_reached")
+
+
+def test_goto_reads_the_goal_from_the_blackboard(tunnel):
+    grid, a, _ = tunnel
+    robot = FakeRobot(grid, body(a, 3.0))
+    ctx = make_ctx(robot)
+    node = GoTo(name="Go", ctx=ctx, goal_key="waypoint")
+    py_trees.blackboard.Blackboard.set("/r1/waypoint", body(a, 10.0, 0.5).tolist())
+    assert run(node, ctx, robot) == Status.SUCCESS
+    assert np.linalg.norm(robot.position[:2] - body(a, 10.0, 0.5)[:2]) <= 1.0
+
+
+def test_goto_fails_with_no_path_for_a_goal_inside_rock(tunnel):
+    grid, a, _ = tunnel
+    robot = FakeRobot(grid, body(a, 3.0))
+    ctx = make_ctx(robot)
+    rock = body(a, 10.0, 2.1)  # beside the 4 m wide tunnel: its mapped wall
+    assert grid.value_at(rock[None])[0] == OCCUPIED
+    node = GoTo(name="Go", ctx=ctx, goal=rock.tolist())
+    assert run(node, ctx, robot) == Status.FAILURE
+    assert node.get(node.k_failure) == "no_path"
+    assert robot.paths == []
+    assert events(ctx, "goto_failed")[0]["goto_failure"] == "no_path"
+
+
+def test_goto_fails_with_no_path_for_a_goal_out_of_reach(tunnel):
+    grid, a, _ = tunnel
+    robot = FakeRobot(grid, body(a, 3.0))
+    ctx = make_ctx(robot)
+    node = GoTo(name="Go", ctx=ctx, goal=body(a, 10.0, 8.0).tolist(), planner="gbplanner")  # deep in the rock
+    assert run(node, ctx, robot) == Status.FAILURE
+    assert node.get(node.k_failure) == "no_path"
+
+
+def test_goto_without_a_goal_fails(tunnel):
+    grid, a, _ = tunnel
+    robot = FakeRobot(grid, body(a, 3.0))
+    ctx = make_ctx(robot)
+    node = GoTo(name="Go", ctx=ctx)
+    assert run(node, ctx, robot) == Status.FAILURE
+    assert node.get(node.k_failure) == "no_goal"
+
+
+def test_goto_from_a_pose_off_the_map_is_an_invalid_start(tunnel):
+    grid, a, _ = tunnel
+    robot = FakeRobot(grid, body(a, 10.0, 4.5))  # inside the rock, 2.5 m from the tunnel
+    ctx = make_ctx(robot)
+    node = GoTo(name="Go", ctx=ctx, goal=body(a, 15.0).tolist())
+    assert run(node, ctx, robot) == Status.FAILURE
+    assert node.get(node.k_failure) == "invalid_start"
+
+
+def test_goto_with_the_global_planner(tunnel):
+    grid, a, _ = tunnel
+    robot = FakeRobot(grid, body(a, 3.0))
+    ctx = make_ctx(robot)
+    goal = body(a, 6.0, 1.0)  # within reach of a direct, collision-checked edge
+    node = GoTo(name="Go", ctx=ctx, goal=goal.tolist(), planner="gbplanner")
+    assert run(node, ctx, robot) == Status.SUCCESS
+    assert events(ctx, "goto")[0]["source"] == "gbplanner2"
+
+
+def test_goto_replans_after_a_blocked_path_and_gives_up(tunnel):
+    grid, a, _ = tunnel
+    robot = FakeRobot(grid, body(a, 3.0))
+    robot.block_at = body(a, 8.0)
+    robot.block_radius_m = 2.5  # the whole tunnel's width
+    ctx = make_ctx(robot)
+    node = GoTo(name="Go", ctx=ctx, goal=body(a, 15.0).tolist(), max_replans=2)
+    assert run(node, ctx, robot) == Status.FAILURE
+    assert node.get(node.k_failure) == "blocked"
+    assert len(robot.paths) == 3
+
+
+# ------------------------------------------------------------------------ Backtrack
+
+
+def test_backtrack_path_cuts_loops_out():
+    out = [(x, 0.0, 1.5) for x in np.arange(0.0, 10.01, 0.5)]      # out along x to 10
+    back = [(x, 0.0, 1.5) for x in np.arange(9.5, 4.99, -0.5)]     # back to 5 (a dead end)
+    side = [(5.0, y, 1.5) for y in np.arange(0.5, 5.01, 0.5)]      # then along y
+    trail = np.array(out + back + side)
+    path = backtrack_path(trail)
+    assert np.allclose(path[0], trail[-1]) and np.allclose(path[-1], trail[0])
+    assert path[:, 0].max() <= 5.0 + 1e-9  # the dead end beyond x = 5 is skipped
+    length = np.linalg.norm(np.diff(path, axis=0), axis=1).sum()
+    assert length == pytest.approx(10.0, abs=1.0)
+    exact = backtrack_path(trail, loop_radius_m=0.0)
+    assert len(exact) == len(trail) and np.allclose(exact, trail[::-1])
+
+
+def test_backtrack_path_stops_after_distance():
+    trail = np.array([(x, 0.0, 1.5) for x in np.arange(0.0, 20.01, 0.5)])
+    path = backtrack_path(trail, 4.2)
+    assert np.allclose(path[0], trail[-1])
+    assert np.allclose(path[-1], (20.0 - 4.2, 0.0, 1.5))
+
+
+def test_exact_rest_of_a_walk_goes_back_to_the_leg_it_was_on():
+    trail = np.array([(0, 0, 1.5), (1, 0, 1.5), (2, 0, 1.5), (2, 1, 1.5), (1.4, 0.2, 1.5)], float)
+    walk = TrailWalk.plan(trail, loop_radius_m=0.75)
+    assert list(walk.indices) == [4, 1, 0]  # the loop through (2, 0) and (2, 1) cut out
+    # Blocked half way along the jump 4 -> 1: back to 4, then every point as walked.
+    rest = walk.exact_rest(np.array([1.2, 0.1, 1.5]))
+    assert np.allclose(rest, trail[::-1])
+
+
+def test_jump_check_refuses_a_trench_for_a_legged_robot():
+    occ = np.full((40, 10, 15), UNKNOWN, np.int8)
+    occ[:, :, 5:] = FREE
+    occ[:, :, 4] = OCCUPIED                   # floor at z = 1.0 (voxel 4 top)
+    occ[18:22, :, 4] = FREE                   # a 0.8 m trench with its bottom 0.6 m lower
+    occ[18:22, :, 1] = OCCUPIED
+    occ[18:22, :, 2:4] = FREE
+    grid = Grid(occ, np.zeros(3), 0.2)
+    legged = FakeRobot(grid, (1.0, 1.0, 1.5))
+    ok = jump_check(legged)
+    assert ok(np.array([1.0, 1.0, 1.5]), np.array([3.0, 1.0, 1.5]))
+    assert not ok(np.array([3.2, 1.0, 1.5]), np.array([4.8, 1.0, 1.5]))
+    aerial = FakeRobot(grid, (1.0, 1.0, 1.5), platform="aerial")
+    assert jump_check(aerial)(np.array([3.2, 1.0, 1.5]), np.array([4.8, 1.0, 1.5]))
+
+
+def straight_trail(a, to_m: float) -> list[np.ndarray]:
+    return [body(a, x) for x in np.arange(2.0, to_m + 1e-9, 0.5)]
+
+
+def test_backtrack_goes_back_the_distance_along_the_trail(tunnel):
+    grid, a, _ = tunnel
+    trail = straight_trail(a, 20.0)
+    robot = FakeRobot(grid, trail[-1], trail=trail)
+    ctx = make_ctx(robot)
+    node = Backtrack(name="Back", ctx=ctx, distance_m=6.0)
+    assert run(node, ctx, robot, dt_s=0.5) == Status.SUCCESS
+    assert np.allclose(robot.position, body(a, 14.0), atol=1e-6)
+    assert node.get(node.k_done) == pytest.approx(6.0, abs=0.01)
+    assert events(ctx, "backtrack")[0]["trigger"] is True
+
+
+def test_backtrack_until_a_blackboard_condition(tunnel):
+    grid, a, _ = tunnel
+    trail = straight_trail(a, 20.0)
+    robot = FakeRobot(grid, trail[-1], trail=trail)
+    ctx = make_ctx(robot)
+    node = Backtrack(name="Back", ctx=ctx, distance_m=None, until_key="radio_ok")
+    py_trees.blackboard.Blackboard.set("/r1/radio_ok", False)
+    for _ in range(5):
+        node.tick_once()
+        robot.step(1.0)
+    assert node.status == Status.RUNNING
+    py_trees.blackboard.Blackboard.set("/r1/radio_ok", True)
+    node.tick_once()
+    assert node.status == Status.SUCCESS
+    assert robot.path_status != PathStatus.FOLLOWING and robot.stops >= 1
+    assert robot.position[0] == pytest.approx(body(a, 15.0)[0], abs=0.01)
+
+
+def test_backtrack_fails_when_the_trail_ends_before_the_condition(tunnel):
+    grid, a, _ = tunnel
+    trail = straight_trail(a, 6.0)
+    robot = FakeRobot(grid, trail[-1], trail=trail)
+    ctx = make_ctx(robot)
+    node = Backtrack(name="Back", ctx=ctx, distance_m=None, until_key="radio_ok")
+    assert run(node, ctx, robot) == Status.FAILURE
+    assert np.allclose(robot.position, trail[0])
+
+
+def test_backtrack_without_a_trail_fails(tunnel):
+    grid, a, _ = tunnel
+    robot = FakeRobot(grid, body(a, 5.0))
+    ctx = make_ctx(robot)
+    node = Backtrack(name="Back", ctx=ctx)
+    assert run(node, ctx, robot) == Status.FAILURE
+    assert events(ctx, "backtrack_failed")
+
+
+def test_backtrack_retries_exactly_as_walked_when_a_loop_cut_is_blocked(tunnel):
+    grid, a, _ = tunnel
+    # Out along one side of the tunnel and back along the other, 1 m apart: the way
+    # back from the end cuts straight across to the start of the first line ...
+    out = [body(a, x, -0.5) for x in np.arange(2.0, 8.01, 0.5)]
+    back = [body(a, x, 0.5) for x in np.arange(8.0, 1.99, -0.5)]
+    trail = out + back
+    robot = FakeRobot(grid, trail[-1], trail=trail)
+    ctx = make_ctx(robot)
+    node = Backtrack(name="Back", ctx=ctx, distance_m=None, loop_radius_m=1.5)
+    # ... which turns out blocked half way across: the rest of the way exactly as walked.
+    robot.block_at, robot.block_radius_m = (trail[0] + trail[-1]) / 2, 0.05
+    assert run(node, ctx, robot, dt_s=0.25) == Status.SUCCESS
+    first, second = robot.paths
+    assert np.allclose(first, [trail[0]])
+    assert events(ctx, "backtrack_blocked")
+    assert np.allclose(second[0], trail[-1]) and len(second) == len(trail)
+    assert np.allclose(robot.position, trail[0])
