@@ -22,7 +22,8 @@ def _subclasses(cls: type) -> list[type]:
 
 
 def all_skills() -> dict[str, type]:
-    """Every concrete behaviour class of this package by its YAML ``type`` name.
+    """Every concrete behaviour class defined in this package, by its YAML ``type`` name.
+
 
     A class is concrete when it sets ``ABSTRACT = False`` (the default); its YAML
     name is its ``TYPE_NAME`` attribute, or its class name.
@@ -32,7 +33,7 @@ def all_skills() -> dict[str, type]:
             importlib.import_module(f"{__name__}.{mod.name}")
     found: dict[str, type] = {}
     for cls in _subclasses(Skill):
-        if cls.__dict__.get("ABSTRACT", False):
-            continue
+        if cls.__dict__.get("ABSTRACT", False) or not cls.__module__.startswith(f"{__name__}."):
+            continue  # abstract, or defined elsewhere (a test's or a user's own registry)
         found[getattr(cls, "TYPE_NAME", cls.__name__)] = cls
     return found
