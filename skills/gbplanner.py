@@ -207,8 +207,6 @@ class Explore(Skill):
     the local gain stayed low for ``low_gain_iterations`` iterations or the local
     planner found no path; with ``endurance_homing`` it also checks at every iteration
     whether the remaining endurance still covers one more step and the way home.
-    With ``relocate``, the first iteration goes to the best frontier of the global
-    graph (the supervisor's "relocate to a frontier, then explore").
     The next iteration starts when the robot has arrived (or its path was blocked).
     The planner's parameters come from the robot's platform (Table I preset: ``legged``
     ANYmal C, ``aerial`` RMF-Obelix) and its mobility limits; the parameters below that
@@ -233,7 +231,6 @@ class Explore(Skill):
     PARAMS = {
         "seed": Param(int, 0, "seeds the planner's random generator (with the agent's name)", minimum=0),
         "endurance_homing": Param(bool, True, "the planner checks at each iteration whether to go home"),
-        "relocate": Param(bool, False, "first go to the best frontier of the global graph, then explore"),
         "max_failed_plans": Param(int, 3, "failed iterations in a row before FAILURE", minimum=1),
         "retry_period_s": Param(float, 2.0, "wait before retrying a failed iteration", minimum=0),
         "max_vertices": Param(int, None, "N_V,max, vertices of the local graph (null: preset, 1000 / 500)",
@@ -267,11 +264,9 @@ class Explore(Skill):
         self.following = False
         self.failures = 0
         self.next_plan_s = -float("inf")
-        self.relocate_pending = False
 
     def initialise(self) -> None:
         self.following, self.failures, self.next_plan_s = False, 0, -float("inf")
-        self.relocate_pending = self.p["relocate"]
 
     def update(self) -> Status:
         r = self.robot
@@ -355,14 +350,6 @@ class Explore(Skill):
             for v in hidden:
                 del gp.frontiers[v]
         try:
-            if self.relocate_pending:
-                self.relocate_pending = False
-                gp.record_position(r.position)
-                rep = gp.plan_reposition(grid, r.position, endurance)
-                if rep.ok:
-                    return PlanResult(rep.path, "reposition", rep.gain, "relocation to the best frontier",
-                                      global_result=rep)
-                self.event("relocate_failed", detail=rep.reason)
             return planner.plan(grid, r.position, svc.rng, yaw_rad=r.yaw_rad, endurance_remaining_s=endurance,
                                 exploration_bounds=bounds)
         finally:
@@ -490,5 +477,5 @@ class Home(Skill):
         self.moving = False
 
 
-__all__ = ["PLAN_REASONS", "Explore", "Home", "PlannerService", "ShrinkingLocalPlanner", "gbplanner", "onboard_grid", "parse_bbox",
-           "plan_reason", "robot_config", "sealed_grid", "stable_seed"]
+__all__ = ["PLAN_REASONS", "Explore", "Home", "PlannerService", "ShrinkingLocalPlanner", "gbplanner",
+           "onboard_grid", "parse_bbox", "plan_reason", "robot_config", "sealed_grid", "stable_seed"]

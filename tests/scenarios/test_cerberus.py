@@ -73,3 +73,16 @@ def test_invalid_start_pose_resets_the_local_map_and_retries():
     assert resets and resets[0]["t"] <= fault["t"] + 30
     assert [e for e in events(mission, "gbplanner_path") if e["t"] > resets[0]["t"]], "exploration did not resume"
     ends_well(mission)
+
+
+def test_supervisor_modes_relocate_breadcrumb_waypoint_home():
+    mission, _ = run_scenario(SCENARIOS_DIR / "cerberus_modes.yaml")
+    relocate = events(mission, "operator_command", command="relocate")
+    assert relocate and events(mission, "relocated")
+    dropped = events(mission, "breadcrumb_dropped")
+    assert dropped and dropped[0]["remaining"] == 3
+    assert any(b.owner == "anymal" for b in mission.radio.active_breadcrumbs())
+    (goto,) = events(mission, "operator_command", command="goto")
+    reached = events(mission, "goto_reached")
+    assert reached and reached[0]["t"] > goto["t"]
+    ends_well(mission)

@@ -9,9 +9,8 @@ import pytest
 from delve.executive.runner import Mission
 from delve.executive.scenario import load_scenario
 
-from delve import SCENARIOS_DIR, TREES_DIR
+from delve import SCENARIOS_DIR
 
-from .conftest import DATA
 
 SCENARIO = SCENARIOS_DIR / "cerberus_inspection.yaml"
 
@@ -23,12 +22,8 @@ def events(mission, name, **match):
 
 @pytest.fixture(scope="module")
 def mission():
-    scenario = load_scenario(SCENARIO)
-    # Until trees/anymal_explorer.yaml includes the inspections block, run a copy that does.
-    if "subtrees/inspections.yaml" not in (TREES_DIR / "anymal_explorer.yaml").read_text():
-        for robot in scenario.robots:
-            robot.tree = DATA / "anymal_explorer_inspections.yaml"
-    m = Mission(scenario)
+    m = Mission(load_scenario(SCENARIO))
+
     m.run()
     return m
 

@@ -1,0 +1,103 @@
+"""COPS planner benchmark: one full cycle (Problem 1 + Problem 2) against network size and
+team size, with and without clustering.
+
+Scenario per cell: a tunnel network from ``tunnel_network_graph(n, seed)``, the base
+station at s0, half the robots at the base and the rest spread over the tunnels (as
+after earlier cycles), frontiers at every dead end. Each integer program is bounded by
+``--time-limit`` seconds (feasibility probes of the horizon search by ``--probe-limit``)
+and a cell whose cycle runs longer than ``--cell-limit`` is skipped for larger teams.
+Printed: wall time of the cycle (median of ``--repeats`` runs where a run is cheap),
+the horizons, the worst optimality gap reported by the solver (None: unknown), and
+whether every plan passes the validator.
+
+    .venv/bin/python bench/cops.py            # the whole table, < 15 min on 2 cores
+    .venv/bin/python bench/cops.py --sizes 100 --robots 10
+"""
+from __future__ import annotations
+
+import argparse
+import random
+import shlex
+import statistics
+import sys
+import time
+
+from delve.planners.cops import (PlanningError, Robot, SolverOptions, available_solver, plan_cycle,
+                                 tunnel_network_graph, validate_plan)
+from delve.planners.cops.network import dead_ends
+
+
+def scenario(n_locations: int, n_robots: int, seed: int):
+    net = tunnel_network_graph(n_locations, seed=seed)
+    rng = random.Random(seed)
+    others = [s for s in net.locations if s != "s0"]
+    for i in range(n_robots):
+        net.add_robot(Robot(f"r{i + 1}", "s0" if i < (n_robots + 1) // 2 else rng.choice(others)))
+    net.frontiers = set(dead_ends(net))
+    return net
+
+
+def run_cell(n: int, r: int, clustered: bool, opts: SolverOptions, seed: int):
+    net = scenario(n, r, seed)
+    t0 = time.perf_counter()
+    try:
+        cyc = plan_cycle(net, clustering=clustered, options=opts)
+    except PlanningError as err:
+        return time.perf_counter() - t0, None, str(err)
+    wall = time.perf_counter() - t0
+    ok = not validate_plan(net, cyc.pre) and not validate_plan(net.with_positions(cyc.pre.final_positions()), cyc.post)
+    return wall, cyc, "valid" if ok else "INVALID"
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--sizes", type=int, nargs="+", default=[25, 50, 100, 200])
+    ap.add_argument("--robots", type=int, nargs="+", default=[2, 5, 10, 20])
+    ap.add_argument("--time-limit", type=float, default=4.0, help="seconds per integer program")
+    ap.add_argument("--probe-limit", type=float, default=1.0, help="seconds per horizon probe")
+    ap.add_argument("--cell-limit", type=float, default=40.0,
+                    help="skip larger teams on a size once a cycle took this long")
+    ap.add_argument("--repeats", type=int, default=3, help="runs per cell when a run takes < 2 s")
+    ap.add_argument("--seed", type=int, default=1)
+    args = ap.parse_args(argv)
+    print("command:", " ".join(shlex.quote(a) for a in [sys.executable] + sys.argv))
+    print(f"solver: {available_solver()}; per-solve limit {args.time_limit:g} s, probe limit {args.probe_limit:g} s")
+    opts = SolverOptions(time_limit_s=args.time_limit, probe_time_limit_s=args.probe_limit, mip_gap=0.01)
+    header = f"{'locations':>9} {'robots':>6} {'clustering':>10} {'cycle_s':>8} {'T_pre':>5} {'T_post':>6} " \
+             f"{'clusters':>8} {'explorers':>9} {'gap':>8}  result"
+    print(header)
+    print("-" * len(header))
+    t_all = time.perf_counter()
+    for n in args.sizes:
+        for clustered in (False, True):
+            skip = False
+            for r in args.robots:
+                label = "yes" if clustered else "no"
+                if skip:
+                    print(f"{n:>9} {r:>6} {label:>10} {'-':>8} {'-':>5} {'-':>6} {'-':>8} {'-':>9} {'-':>8}  "
+                          f"skipped (a smaller team already took > {args.cell_limit:g} s)")
+                    continue
+                walls = []
+                wall, cyc, result = run_cell(n, r, clustered, opts, args.seed)
+                walls.append(wall)
+                if cyc is not None and wall < 2.0:
+                    for _ in range(args.repeats - 1):
+                        walls.append(run_cell(n, r, clustered, opts, args.seed)[0])
+                med = statistics.median(walls)
+                if cyc is None:
+                    print(f"{n:>9} {r:>6} {label:>10} {med:>8.2f} {'-':>5} {'-':>6} {'-':>8} {'-':>9} {'-':>8}  "
+                          f"no plan: {result}")
+                else:
+                    gap = cyc.meta.get("gap")
+                    gap_s = "None" if gap is None else f"{gap:.3f}"
+                    print(f"{n:>9} {r:>6} {label:>10} {med:>8.2f} {cyc.pre.horizon:>5} {cyc.post.horizon:>6} "
+                          f"{cyc.meta.get('clusters', 1):>8} {len(cyc.pre.explore):>9} {gap_s:>8}  {result}")
+                sys.stdout.flush()
+                if med > args.cell_limit:
+                    skip = True
+    print(f"total {time.perf_counter() - t_all:.0f} s")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,94 @@
+"""Relocate to a frontier (the supervisor's third mode of operation) and drop WiFi
+breadcrumbs."""
+from __future__ import annotations
+
+from typing import Any
+
+from py_trees.common import Access, Status
+
+from .base import Param, Skill
+from .gbplanner import gbplanner
+from .navigation import navigator
+from .robot import PathStatus
+
+
+class Relocate(Skill):
+    """Relocate to the best frontier of GBPlanner2's global graph (gain over path
+    length, among frontiers from which the robot can still get home).
+
+    Writes ``relocation_target``. Returns RUNNING on the way; SUCCESS on arrival (the
+    tree then explores from there); FAILURE when the global graph has no frontier, or
+    the path is blocked ``max_replans`` times (the reason in the log).
+    """
+
+    PARAMS = {"max_replans": Param(int, 3, "re-plans allowed after a blocked path", minimum=0)}
+
+    def __init__(self, name: str, ctx: Any, remap: dict[str, str] | None = None, **params: Any):
+        super().__init__(name, ctx, remap, **params)
+        self.k_target = self.key("relocation_target")
+        self.moving, self.replans = False, 0
+
+    def initialise(self) -> None:
+        self.moving, self.replans = False, 0
+
+    def update(self) -> Status:
+        r = self.robot
+        if self.moving:
+            if r.path_status == PathStatus.FOLLOWING:
+                return Status.RUNNING
+            if r.path_status == PathStatus.ARRIVED:
+                self.event("relocated", at=[round(float(v), 2) for v in r.position])
+                return Status.SUCCESS
+            self.replans += 1
+            if self.replans > self.p["max_replans"]:
+                return self._fail(f"path blocked {self.replans} times")
+        planner = gbplanner(self.ctx, r).planner
+        res = planner.global_planner.plan_reposition(navigator(self.ctx, r).grid(), r.position,
+                                                     r.endurance_remaining_s)
+        if res.path is None:
+            return self._fail(res.reason or "no frontier to relocate to")
+        self.follow(res.path)
+        self.moving = True
+        target = [round(float(v), 2) for v in res.target] if res.target is not None else None
+        self.bb.set(self.k_target, target)
+        self.event("relocate", trigger=True, to=target, path_length_m=round(res.length_m, 1))
+        return Status.RUNNING
+
+    def terminate(self, new_status: Status) -> None:
+        if new_status == Status.INVALID:
+            self.stop_own_motion()
+        self.moving = False
+
+    def _fail(self, reason: str) -> Status:
+        self.feedback_message = reason
+        self.event("relocate_failed", reason=reason)
+        return Status.FAILURE
+
+
+class DeployBreadcrumb(Skill):
+    """Drop a WiFi breadcrumb on the ground under the robot (Carrier ANYmals hold four).
+
+    Reads and clears ``breadcrumb_request``. Returns SUCCESS when a breadcrumb was
+    dropped; FAILURE when none is requested, or when the robot has none left or no
+    ground to drop it on (the reason in the log; never an exception).
+    """
+
+    def __init__(self, name: str, ctx: Any, remap: dict[str, str] | None = None, **params: Any):
+        super().__init__(name, ctx, remap, **params)
+        self.k_request = self.key("breadcrumb_request", Access.WRITE)
+
+    def update(self) -> Status:
+        if not self.get(self.k_request):
+            return Status.FAILURE
+        self.bb.set(self.k_request, False)
+        drop = self.robot.deploy_breadcrumb()
+        if not drop.ok:
+            self.feedback_message = drop.error
+            self.event("breadcrumb_failed", reason=drop.error)
+            return Status.FAILURE
+        self.event("breadcrumb_dropped", trigger=True, name=drop.name, remaining=drop.remaining,
+                   at=[round(float(v), 2) for v in self.robot.position])
+        return Status.SUCCESS
+
+
+__all__ = ["DeployBreadcrumb", "Relocate"]

@@ -1,0 +1,17 @@
+"""A legged and an aerial robot with the CERBERUS trees on two levels joined by a
+ramp beyond the legged limit and a vertical shaft."""
+from delve import SCENARIOS_DIR
+
+from .conftest import run_scenario
+from .test_cerberus import ends_well
+
+
+def test_legged_robot_refuses_the_steep_ramp_while_the_aerial_robot_flies_the_shaft():
+    mission, _ = run_scenario(SCENARIOS_DIR / "cerberus_slopes_shaft.yaml")
+    g = mission.world.centreline
+    upper_floor = min(float(g.nodes[n]["pos"][2]) for n in g.nodes if g.nodes[n].get("level") == 1)
+    legged_top = max(p[2] for p in mission.robots["anymal"].traversed_path)
+    aerial_top = max(p[2] for p in mission.robots["obelix"].traversed_path)
+    assert legged_top < upper_floor - 2.0
+    assert aerial_top > upper_floor
+    ends_well(mission)
