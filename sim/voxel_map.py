@@ -29,6 +29,7 @@ class VoxelMap:
         self._free = np.zeros(0, dtype=np.int64)
         self._new_free: list[np.ndarray] = []
         self._free_stale = False
+        self._refreed = False
 
     @property
     def shape(self) -> tuple[int, int, int]:
@@ -94,10 +95,10 @@ class VoxelMap:
         self.occupancy.reshape(-1)[flat] = value
         self._dirty.reshape(-1)[flat] = True
         self._free_stale = True
+        self._refreed = True  # a voxel set here may be freed again by a later scan
         self.version += 1
 
     def free_voxels(self) -> np.ndarray:
-
         """Flat indices of the FREE voxels, in the order they became free. Kept up to
         date as scans arrive, so planners need not scan the whole grid."""
         if self._new_free:
@@ -105,10 +106,11 @@ class VoxelMap:
             self._new_free = []
         if self._free_stale:
             self._free = self._free[self.occupancy.reshape(-1)[self._free] == FREE]
-            _, first = np.unique(self._free, return_index=True)  # a voxel freed twice
-            self._free = self._free[np.sort(first)]
-
             self._free_stale = False
+        if self._refreed:
+            _, first = np.unique(self._free, return_index=True)  # voxels freed twice
+            self._free = self._free[np.sort(first)]
+            self._refreed = False
         return self._free
 
     def take_changes(self) -> tuple[np.ndarray, np.ndarray]:
@@ -126,7 +128,6 @@ class VoxelMap:
         self._free_stale = True
         occ[flat] = merged
         self.version += 1
-
 
     def known_fraction_of(self, flat: np.ndarray) -> float:
         """Fraction of the voxels ``flat`` that this map knows as FREE."""

@@ -39,3 +39,17 @@ def test_changes_are_taken_once_and_merge_keeps_occupied():
     c.merge(flat, values)
     assert np.array_equal(c.occupancy, a.occupancy)
     assert 0 < c.known_fraction_of(np.arange(c.occupancy.size)) < 1
+
+
+def test_free_voxels_track_scans_resets_and_rescans_without_duplicates():
+    m = VoxelMap((30, 10, 10), np.zeros(3), 0.2)
+    sensor, ray = np.array([0.1, 1.0, 1.0]), np.array([[1.0, 0.0, 0.0]])
+    m.integrate_scan(sensor, ray, np.array([4.0]), 5.0)
+    first = m.free_voxels().copy()
+    assert np.array_equal(np.sort(first), np.flatnonzero(m.occupancy.reshape(-1) == FREE))
+    m.set_sphere(sensor + [1.0, 0, 0], 0.5, UNKNOWN)  # forget part of it
+    assert len(m.free_voxels()) < len(first)
+    m.integrate_scan(sensor, ray, np.array([4.0]), 5.0)  # and map it again
+    again = m.free_voxels()
+    assert len(np.unique(again)) == len(again)
+    assert np.array_equal(np.sort(again), np.sort(first))
