@@ -983,8 +983,8 @@ def reference_markdown(registry: Registry | None = None) -> str:
     """The node reference (docs/nodes.md): every node type with its parameters."""
     registry = default_registry() if registry is None else registry
     out = ["# Node reference", "",
-           f"Every node type a YAML tree can name. Generated from the registry by "
-           f"`python -m delve.executive.registry --write-docs`; do not edit by hand.", ""]
+           "Every node type a YAML tree can name. Generated from the registry by "
+           "`python -m delve.executive.registry --write-docs`; do not edit by hand.", ""]
     titles = {"composite": "Composites", "decorator": "Decorators", "behaviour": "Behaviours",
               "idiom": "Idioms", "skill": "Skills"}
     for kind in KINDS:

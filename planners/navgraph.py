@@ -16,7 +16,7 @@ from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import dijkstra
 from scipy.spatial import cKDTree
 
-from .occupancy import FREE, OCCUPIED, UNKNOWN, Grid
+from .occupancy import OCCUPIED, UNKNOWN, Grid
 
 FACES = ((1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0), (0, 0, 1), (0, 0, -1))
 _NEIGHBOURS_8 = [(di, dj) for di in (-1, 0, 1) for dj in (-1, 0, 1) if (di, dj) != (0, 0)]
@@ -168,7 +168,7 @@ def legged_graph(
     ``ground_inference_radius_m``. The ground inclination is estimated by central
     differences of standable heights ``inclination_baseline_m`` apart.
     """
-    shape, vox = grid.shape, grid.voxel_size_m
+    vox = grid.voxel_size_m
     flat_occ = grid.occupancy.reshape(-1)
     free = Voxels.free_of(grid)
 

@@ -16,6 +16,7 @@ from .validator import Violation, validate_plan
 
 __all__ = [
     "MASTER", "Communication", "ConnectivityProblem", "CyclePlan", "ExplorationTask", "FrontierReward",
+    "exploration_tasks",
     "InfeasibleProblem", "MCNetwork", "Plan", "PlanningError", "Requirement", "Robot", "SolverOptions",
     "SolverTimeout", "Step", "Violation", "add_team", "available_solver", "dead_ends",
     "information_distance", "network_from_dict", "plan_cost", "plan_cycle", "reconstruct_communications",

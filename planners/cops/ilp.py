@@ -364,7 +364,6 @@ class _Model:
             return pulp.lpSum([occ(c, t, v) for c in home_classes.get(v, [])])
 
         # ---- master information m ---------------------------------------------------------
-        g: dict[tuple[str, int], object] = {}
         w: dict[tuple[str, int], pulp.LpVariable] = {}
         self.w = w
         h_cache: dict[tuple[str, int], object] = {}
