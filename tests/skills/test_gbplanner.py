@@ -230,21 +230,6 @@ def test_explore_stays_inside_the_exploration_box(half_mapped):
         assert path[:, 0].max() <= a[0] + 15.0 + 0.6  # vertices in the box; improvement moves them <= 0.5 m
 
 
-def test_relocate_goes_to_the_best_frontier_first(half_mapped):
-    grid, a, _ = half_mapped
-    robot = FakeRobot(grid, body(a, 8.0))
-    ctx = make_ctx(robot)
-    node = explore(ctx)
-    node.tick_once()
-    robot.step(100.0)
-    node.stop(Status.INVALID)
-    frontiers = gbplanner(ctx, robot).planner.global_planner.frontiers
-    assert frontiers
-    relocating = explore(ctx, relocate=True)
-    relocating.tick_once()
-    assert bb("planner_mode") == "reposition" and bb("last_plan_reason") == "reposition"
-
-
 def test_shrinking_local_planner_refills_a_graph_starved_box(monkeypatch):
     """A 2 m wide tunnel in a wide, mostly rock and unknown local box: graph building
     stops after its first batch of samples, and the smaller box fills with vertices."""
