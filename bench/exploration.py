@@ -15,7 +15,8 @@ seed per worker process.
     .venv/bin/python bench/exploration.py [--quick] [--seeds 1 2 3] [--jobs 2]
 
 Prints the command, one row per run, then the median T90 per planner and world and
-the ratio GBPlanner2 / baseline (goal: at most 0.8).
+the ratio GBPlanner2 / baseline (goal: at most 0.8), and the same for T80 (80 %
+coverage), since parts of some generated worlds are out of a legged robot's reach.
 """
 from __future__ import annotations
 
@@ -45,13 +46,17 @@ TREES = {
 #: name -> world section of a scenario (generator parameters).
 WORLDS = {
     "tunnel_network": {"generator": "tunnel_network", "total_length_m": 300, "loops": 2, "max_slope_deg": 30},
-    "two_level_ramp": {"generator": "tunnel_network", "total_length_m": 300, "levels": 2, "ramp": True, "loops": 1},
-    "cave": {"generator": "cave", "total_length_m": 250, "shaft": False, "width_m": [2.0, 8.0], "height_m": [2.0, 5.0]},
+    "two_level_ramp": {"generator": "tunnel_network", "total_length_m": 300, "levels": 2, "ramp": True, "loops": 1,
+                       "max_slope_deg": 20},
+    "cave": {"generator": "cave", "total_length_m": 250, "shaft": False, "width_m": [2.0, 6.0], "height_m": [2.0, 4.0]},
 }
 QUICK_LENGTH_M = {"tunnel_network": 150, "two_level_ramp": 200, "cave": 130}
 ENDURANCE_S = 1800.0
 DURATION_S = 2400.0
 TARGET = 0.90
+#: A second, lower target, reported too: where parts of a world are out of a legged
+#: robot's reach, neither planner may reach 90 %.
+TARGET_LOW = 0.80
 
 
 @dataclass
@@ -60,6 +65,7 @@ class Run:
     seed: int
     planner: str
     t90_s: float | None
+    t80_s: float | None
     final_coverage: float
     sim_time_s: float
     distance_m: float
@@ -94,7 +100,6 @@ def t_reach(samples: list, fraction: float) -> float | None:
 def run_world(job: tuple[str, dict, int]) -> list[Run]:
     """Both planners on one world and seed (the world is generated once)."""
     import numpy as np
-
     from delve.executive.runner import Mission
     from delve.executive.scenario import load_scenario
 
@@ -114,7 +119,7 @@ def run_world(job: tuple[str, dict, int]) -> list[Run]:
             wall = time.perf_counter() - t
             robot = mission.robots["anymal"]
             out.append(Run(name, seed, planner, t_reach(mission.state.samples, TARGET),
-                           mission.state.samples[-1].team, mission.clock.now_s, robot.distance_m,
+                           t_reach(mission.state.samples, TARGET_LOW), mission.state.samples[-1].team, mission.clock.now_s, robot.distance_m,
                            bool(np.linalg.norm(robot.position - robot.home) <= 1.5), mission.succeeded, wall))
     return out
 
@@ -123,10 +128,10 @@ def fmt_t(t: float | None) -> str:
     return "not reached" if t is None else f"{t:.0f}"
 
 
-def median_t90(runs: list[Run]) -> float | None:
-    """Median T90, counting "not reached" as later than any time (None when the median
+def median_t(times: list[float | None]) -> float | None:
+    """Median time, counting "not reached" as later than any time (None when the median
     itself is not reached)."""
-    values = sorted((r.t90_s if r.t90_s is not None else float("inf")) for r in runs)
+    values = sorted((t if t is not None else float("inf")) for t in times)
     m = statistics.median(values)
     return None if m == float("inf") else m
 
@@ -134,11 +139,11 @@ def median_t90(runs: list[Run]) -> float | None:
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="smaller worlds and one seed (a minute or two)")
-    ap.add_argument("--seeds", type=int, nargs="+", default=None, help="world/mission seeds (default 1 2 3)")
+    ap.add_argument("--seeds", type=int, nargs="+", default=None, help="world/mission seeds (default 1 to 5)")
     ap.add_argument("--worlds", nargs="+", choices=sorted(WORLDS), default=list(WORLDS))
     ap.add_argument("--jobs", type=int, default=min(2, os.cpu_count() or 1), help="worker processes")
     args = ap.parse_args(argv)
-    seeds = args.seeds or ([1] if args.quick else [1, 2, 3])
+    seeds = args.seeds or ([1] if args.quick else [1, 2, 3, 4, 5])
     print("$ " + " ".join(shlex.quote(a) for a in [Path(sys.executable).name, *sys.argv]))
     print()
     worlds = {}
@@ -171,28 +176,30 @@ def main(argv: list[str] | None = None) -> int:
     else:
         for job in jobs:
             done(run_world(job))
-    header = (f"{'world':<16}{'seed':>5}  {'planner':<11}{'T90 (s)':>12}{'final cov':>11}{'end (s)':>9}"
-              f"{'dist (m)':>10}{'home':>6}{'wall (s)':>10}")
+    header = (f"{'world':<16}{'seed':>5}  {'planner':<11}{'T90 (s)':>12}{'T80 (s)':>12}{'final cov':>11}"
+              f"{'end (s)':>9}{'dist (m)':>10}{'home':>6}{'wall (s)':>10}")
     print(header)
     print("-" * len(header))
     for r in sorted(runs, key=lambda r: (list(worlds).index(r.world), r.seed, r.planner)):
-        print(f"{r.world:<16}{r.seed:>5}  {r.planner:<11}{fmt_t(r.t90_s):>12}{r.final_coverage:>10.1%}"
+        print(f"{r.world:<16}{r.seed:>5}  {r.planner:<11}{fmt_t(r.t90_s):>12}{fmt_t(r.t80_s):>12}"
+              f"{r.final_coverage:>10.1%}"
               f"{r.sim_time_s:>9.0f}{r.distance_m:>10.0f}{'yes' if r.returned_home else 'no':>6}{r.wall_s:>10.1f}")
     print()
-    header = f"{'world':<16}{'median T90 GBPlanner2':>23}{'median T90 frontier':>21}{'ratio':>8}"
-    print(header)
-    print("-" * len(header))
-    ratios = []
-    for name in worlds:
-        gb = median_t90([r for r in runs if r.world == name and r.planner == "GBPlanner2"])
-        fr = median_t90([r for r in runs if r.world == name and r.planner == "frontier"])
-        ratio = gb / fr if gb is not None and fr is not None else None
-        if ratio is not None:
-            ratios.append(ratio)
-        print(f"{name:<16}{fmt_t(gb):>23}{fmt_t(fr):>21}{'—' if ratio is None else f'{ratio:.2f}':>8}")
-    if ratios:
-        print(f"{'all worlds':<16}{'':>23}{'':>21}{statistics.median(ratios):>8.2f}  (median of the ratios)")
-    print()
+    for label, attr in (("T90", "t90_s"), ("T80", "t80_s")):
+        header = f"{'world':<16}{'median ' + label + ' GBPlanner2':>23}{'median ' + label + ' frontier':>21}{'ratio':>8}"
+        print(header)
+        print("-" * len(header))
+        ratios = []
+        for name in worlds:
+            gb = median_t([getattr(r, attr) for r in runs if r.world == name and r.planner == "GBPlanner2"])
+            fr = median_t([getattr(r, attr) for r in runs if r.world == name and r.planner == "frontier"])
+            ratio = gb / fr if gb is not None and fr is not None else None
+            if ratio is not None:
+                ratios.append(ratio)
+            print(f"{name:<16}{fmt_t(gb):>23}{fmt_t(fr):>21}{'—' if ratio is None else f'{ratio:.2f}':>8}")
+        if ratios:
+            print(f"{'all worlds':<16}{'':>23}{'':>21}{statistics.median(ratios):>8.2f}  (median of the ratios)")
+        print()
     print(f"goal: T90 ratio GBPlanner2 / baseline <= 0.8; total wall time {time.perf_counter() - t0:.0f} s")
     return 0
 

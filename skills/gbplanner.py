@@ -15,8 +15,17 @@ from typing import Any
 import numpy as np
 from py_trees.common import Access, Status
 
-from ..planners.gbplanner2 import GBPlanner, GBPlannerConfig, LocalBound, LocalPlanner, LocalPlanResult, PlanResult
-from ..planners.occupancy import OCCUPIED, UNKNOWN, Grid
+from ..planners.gbplanner2 import (
+    Frontier,
+    GBPlanner,
+    GBPlannerConfig,
+    LocalBound,
+    LocalMap,
+    LocalPlanner,
+    LocalPlanResult,
+    PlanResult,
+)
+from ..planners.occupancy import FREE, OCCUPIED, UNKNOWN, Grid
 from .base import AgentContext, Param, Skill
 from .navigation import navigator
 from .robot import PathStatus, Robot
@@ -34,6 +43,9 @@ class PlannerService:
     rng: np.random.Generator
     overrides: dict[str, Any] = field(default_factory=dict)
     plans: int = 0
+    #: Where the robot's paths were blocked although its map showed a way (body-centre
+    #: points just ahead of it): the planner sees rock there from then on.
+    blocked_spots: list[np.ndarray] = field(default_factory=list)
 
 
 class ShrinkingLocalPlanner(LocalPlanner):
@@ -71,13 +83,19 @@ class ShrinkingLocalPlanner(LocalPlanner):
 def robot_config(robot: Robot, overrides: dict[str, Any] | None = None) -> GBPlannerConfig:
     """GBPlanner2's configuration for ``robot``: the Table I preset of its platform
     (``legged``: ANYmal C, ``aerial``: RMF-Obelix), adapted to its mobility limits and
-    remaining endurance, then ``overrides`` (GBPlannerConfig field names) on top."""
+    remaining endurance, then ``overrides`` (GBPlannerConfig field names) on top.
+
+    The collision box's horizontal sides are the robot's diameter less one voxel of
+    its map: the planner rounds the box out to whole voxels on each side (a 0.8 m box
+    covers five 0.2 m voxels, 1.0 m), which would make the robot a voxel wider than it
+    is and shut it out of squeezes it fits through."""
     mob = robot.mobility
     preset = robot.platform if robot.platform in ("legged", "aerial") else ("aerial" if mob.aerial else "legged")
+    radius = max(mob.radius_m - 0.5 * robot.onboard_map.voxel_size_m, 0.5 * robot.onboard_map.voxel_size_m)
     cfg = GBPlannerConfig.preset(preset).with_robot_limits(
         speed_mps=mob.speed_mps,
         body_height_m=mob.body_height_m,
-        radius_m=mob.radius_m,
+        radius_m=radius,
         max_inclination_deg=mob.max_inclination_deg,
         max_step_m=mob.max_step_m,
         endurance_s=max(robot.endurance_remaining_s, 1.0),
@@ -138,6 +156,79 @@ def sealed_grid(grid: Grid) -> Grid:
     return Grid(out, grid.origin, grid.voxel_size_m, grid.free)
 
 
+def mark_blocked_spots(grid: Grid, spots: list[np.ndarray], radius_m: float, below_m: float) -> Grid:
+    """A copy of ``grid`` with rock at each spot: every voxel within ``radius_m``
+    horizontally, from ``below_m`` under the spot to ``radius_m`` above it."""
+    if not spots or radius_m <= 0:
+        return grid
+    occ = grid.occupancy.copy()
+    vs = grid.voxel_size_m
+    r = radius_m / vs
+    for p in spots:
+        lo = grid.to_index(np.array([[p[0] - radius_m, p[1] - radius_m, p[2] - below_m]]))[0]
+        hi = grid.to_index(np.array([[p[0] + radius_m, p[1] + radius_m, p[2] + radius_m]]))[0] + 1
+        lo, hi = np.maximum(lo, 0), np.minimum(hi, np.array(occ.shape))
+        if np.any(hi <= lo):
+            continue
+        c = grid.to_index(np.asarray(p, float)[None])[0]
+        ii, jj = np.meshgrid(np.arange(lo[0], hi[0]), np.arange(lo[1], hi[1]), indexing="ij")
+        disc = (ii - c[0]) ** 2 + (jj - c[1]) ** 2 <= r * r
+        occ[lo[0]:hi[0], lo[1]:hi[1], lo[2]:hi[2]][disc] = OCCUPIED
+    return Grid(occ, grid.origin, grid.voxel_size_m, None)
+
+
+def blocked_spot(position: np.ndarray, path: np.ndarray | None, ahead_m: float) -> np.ndarray | None:
+    """The point ``ahead_m`` in front of ``position`` (horizontally) towards where
+    ``path`` went on from the segment nearest to it; None without a direction."""
+    if path is None or len(path) == 0:
+        return None
+    pts = np.vstack([position, path]) if len(path) == 1 else path
+    a, b = pts[:-1], pts[1:]
+    ab = b - a
+    t = np.clip(np.einsum("ij,ij->i", position - a, ab) / np.maximum(np.einsum("ij,ij->i", ab, ab), 1e-12), 0, 1)
+    k = int(np.argmin(np.linalg.norm(a + t[:, None] * ab - position, axis=1)))
+    for q in pts[k + 1:]:
+        d = (q - position)[:2]
+        n = float(np.hypot(d[0], d[1]))
+        if n > 0.05:
+            return np.array([position[0] + d[0] / n * ahead_m, position[1] + d[1] / n * ahead_m, position[2]])
+    return None
+
+
+def start_pose(grid: Grid, config: GBPlannerConfig, position: np.ndarray, max_shift_m: float) -> np.ndarray:
+    """Where the planner starts: the robot's position or, when the robot box there
+    touches mapped rock (the robot stands close to a wall or on a sloping floor, and
+    the box is rounded up to whole voxels), the nearest point at most
+    ``max_shift_m`` away (sideways, or up) whose box is clear; the position itself
+    when there is none."""
+    position = np.asarray(position, float)
+    if max_shift_m <= 0:
+        return position
+    lm = LocalMap(grid, position - max_shift_m - 1.0, position + max_shift_m + 1.0, config)
+    if not lm.box_has_occupied(position):
+        return position
+    vs = grid.voxel_size_m
+    n = int(max_shift_m // vs + 1e-9)
+    steps = np.arange(-n, n + 1) * vs
+    dx, dy, dz = np.meshgrid(steps, steps, steps[steps >= 0], indexing="ij")
+    shifts = np.stack([dx.ravel(), dy.ravel(), dz.ravel()], axis=1)
+    shifts = shifts[np.linalg.norm(shifts, axis=1) <= max_shift_m + 1e-9]
+    shifts = shifts[np.argsort(np.linalg.norm(shifts, axis=1), kind="stable")]
+    for d in shifts[1:]:
+        p = position + d
+        if lm.value(p[None])[0] == FREE and not lm.box_has_occupied(p):
+            return p
+    return position
+
+
+def _frontier_of(res: PlanResult, iteration: int) -> Frontier | None:
+    """The frontier a repositioning result leads to (its last global vertex)."""
+    g = res.global_result
+    if res.mode != "reposition" or g is None or not g.vertices or g.target is None:
+        return None
+    return Frontier(int(g.vertices[-1]), np.asarray(g.target, float).copy(), float(g.gain), iteration)
+
+
 def parse_bbox(value: Any) -> tuple[np.ndarray, np.ndarray] | None:
     """An exploration bounding box from the blackboard: ``{min: [x, y, z], max: [x, y, z]}``
     or ``[[x, y, z], [x, y, z]]`` (either corner order); None when unset.
@@ -179,14 +270,16 @@ _OVERRIDES = {
 
 
 #: Codes ``Explore`` writes to ``last_plan_reason``.
-PLAN_REASONS = ("ok", "reposition", "homing_due", "exploration_complete", "invalid_start", "no_path", "error")
+PLAN_REASONS = ("ok", "reposition", "homing_due", "exploration_complete", "invalid_start", "no_path", "blocked",
+                "error")
 
 # Local planner reasons that mean the robot's start pose is invalid on its map.
 _INVALID_START = ("start position is invalid", "robot position is outside the map", "robot position is not finite")
 
 
 def plan_reason(res: PlanResult) -> str:
-    """The code of a :class:`PlanResult` (one of :data:`PLAN_REASONS` but ``error``)."""
+    """The code of a :class:`PlanResult` (one of :data:`PLAN_REASONS` but ``blocked``
+    and ``error``, which come from the robot and from exceptions)."""
     if res.homing is not None and res.homing.required:
         return "homing_due"
     if res.ok:
@@ -207,7 +300,11 @@ class Explore(Skill):
     the local gain stayed low for ``low_gain_iterations`` iterations or the local
     planner found no path; with ``endurance_homing`` it also checks at every iteration
     whether the remaining endurance still covers one more step and the way home.
-    The next iteration starts when the robot has arrived (or its path was blocked).
+    The next iteration starts when the robot has arrived. A blocked path is first
+    re-planned on the terrain-aware navigation graph of the onboard map, to the
+    farthest of its poses that graph reaches (``reroute_poses``); where that is
+    blocked too (a step or trench finer than the voxels), the planner sees rock from
+    then on (``no_go_radius_m``) and plans again.
     The planner's parameters come from the robot's platform (Table I preset: ``legged``
     ANYmal C, ``aerial`` RMF-Obelix) and its mobility limits; the parameters below that
     are not null override them, and ``planner`` overrides any GBPlannerConfig field.
@@ -218,14 +315,15 @@ class Explore(Skill):
     repositioned to.
     Writes: ``planner_mode`` (explore, reposition, homing, none),
     ``last_plan_reason`` (ok, reposition, homing_due, exploration_complete,
-    invalid_start, no_path, error), ``last_plan_detail`` (the planner's words),
+    invalid_start, no_path, blocked, error), ``last_plan_detail`` (the planner's words),
     ``exploration_complete`` (True when nothing is left to explore), ``homing_due``
     (True when the planner decided that the endurance calls for homing).
     Returns: RUNNING while exploring (also after a failed iteration, which is retried
     after ``retry_period_s``); SUCCESS when the exploration is complete or homing is
     due (the tree's ``Home`` then walks the way home); FAILURE at once when the start
-    pose is invalid or the planner raises, and after ``max_failed_plans`` failed
-    iterations in a row (the reason is logged as ``explore_failed``).
+    pose is invalid or the planner raises, after ``max_failed_plans`` failed
+    iterations in a row, and after ``max_blocked_paths`` paths in a row blocked
+    without progress (the reason is logged as ``explore_failed``).
     """
 
     PARAMS = {
@@ -247,6 +345,13 @@ class Explore(Skill):
                                      minimum=1, nullable=True),
         "planner": Param(dict, {}, "further GBPlannerConfig overrides by field name, e.g. {leaf_only_gain: true}"),
         "seal_map_holes": Param(bool, True, "the planner sees unknown voxels next to mapped rock as rock"),
+        "no_go_radius_m": Param(float, 0.3, "where a path was blocked the planner sees rock this wide (0: off)",
+                                minimum=0),
+        "max_blocked_paths": Param(int, 3, "paths blocked in a row, without progress, before FAILURE", minimum=1),
+        "start_shift_m": Param(float, 0.4, "when the robot box touches rock, plan from a clear point this near "
+                                           "(0: off)", minimum=0),
+        "reroute_poses": Param(int, 5, "a blocked path is re-planned on the navigation graph to the farthest of "
+                                       "this many of its poses (0: off)", minimum=0),
     }
 
     def __init__(self, name: str, ctx: Any, remap: dict[str, str] | None = None, **params: Any):
@@ -264,9 +369,15 @@ class Explore(Skill):
         self.following = False
         self.failures = 0
         self.next_plan_s = -float("inf")
+        self.path: np.ndarray | None = None
+        self.rerouted = False
+        self.frontier: Frontier | None = None
+        self.blocked = 0
+        self.blocked_at: np.ndarray | None = None
 
     def initialise(self) -> None:
         self.following, self.failures, self.next_plan_s = False, 0, -float("inf")
+        self.path, self.rerouted, self.frontier, self.blocked, self.blocked_at = None, False, None, 0, None
 
     def update(self) -> Status:
         r = self.robot
@@ -276,10 +387,80 @@ class Explore(Skill):
                 return Status.RUNNING
             self.following = False
             if status == PathStatus.BLOCKED:
-                self.event("explore_path_blocked", reason=getattr(r, "blocked_reason", ""))
+                if not self.rerouted and self._reroute():
+                    return Status.RUNNING
+                if self._path_blocked():
+                    return Status.FAILURE
+            else:
+                self.blocked = 0
         if self.ctx.clock.now_s < self.next_plan_s:
             return Status.RUNNING
         return self._plan()
+
+    def _reroute(self) -> bool:
+        """The planner's path is blocked: follow the navigation graph of the onboard map
+        (terrain-aware: steps, slopes, standable ground) to the farthest pose of that
+        path it reaches, as the paper's legged robots hand the exploration path to
+        their navigation planner. False when it reaches none of them."""
+        r, path = self.robot, self.path
+        if path is None or not self.p["reroute_poses"]:
+            return False
+        nav = navigator(self.ctx, r)
+        plan = nav.from_robot(force=True)
+        if plan is None:
+            return False
+        pos, reason = r.position, getattr(r, "blocked_reason", "")
+        poses = [q for q in path[::-1] if np.linalg.norm((q - pos)[:2]) > 1.0][: self.p["reroute_poses"]]
+        for q in poses:
+            node = nav.node_near(plan.graph, q)
+            if node is None or not np.isfinite(plan.distances[node]) or node == plan.source:
+                continue
+            route = plan.path_to(node)
+            self.follow(route)
+            self.following, self.rerouted, self.path = True, True, route
+            self.event("explore_rerouted", to=_xyz(route[-1]), path_length_m=round(float(plan.distances[node]), 1),
+                       reason=reason)
+            return True
+        return False
+
+    def _restore_frontier(self) -> None:
+        """The frontier a blocked repositioning path led to is still unexplored: give it
+        back to the global planner (which dropped it when it planned the path)."""
+        f, self.frontier = self.frontier, None
+        if f is None:
+            return
+        gp = gbplanner(self.ctx, self.robot).planner.global_planner
+        if f.vertex in gp.graph and f.vertex not in gp.frontiers:
+            gp.frontiers[f.vertex] = f
+            gp.graph.nodes[f.vertex]["kind"] = "frontier"
+
+    def _path_blocked(self) -> bool:
+        """Remember where the path was blocked (the planner's map showed a way there);
+        True when too many paths in a row were blocked without progress."""
+        r = self.robot
+        reason = getattr(r, "blocked_reason", "")
+        pos = r.position
+        progress = self.blocked_at is None or np.linalg.norm(pos - self.blocked_at) > 2.0 * r.mobility.radius_m
+        self.blocked = 1 if progress else self.blocked + 1
+        self.blocked_at = pos
+        spot = None
+        if self.p["no_go_radius_m"] > 0:
+            # Far enough ahead that the robot's own box stays clear of it.
+            ahead = r.mobility.radius_m + self.p["no_go_radius_m"] + 2.0 * r.onboard_map.voxel_size_m
+            spot = blocked_spot(pos, self.path, ahead)
+            if spot is not None:
+                gbplanner(self.ctx, r).blocked_spots.append(spot)
+        self.event("explore_path_blocked", reason=reason, no_go=None if spot is None else _xyz(spot),
+                   in_a_row=self.blocked)
+        self._restore_frontier()
+        if self.blocked < self.p["max_blocked_paths"]:
+            return False
+        detail = f"{self.blocked} paths blocked in a row ({reason})"
+        self._write("none", "blocked", detail)
+        self.feedback_message = detail
+        self.event("explore_failed", reason="blocked", detail=detail)
+        self.blocked, self.blocked_at = 0, None
+        return True
 
     def terminate(self, new_status: Status) -> None:
         if new_status == Status.INVALID and self.following and self.ctx.robot is not None:
@@ -294,6 +475,10 @@ class Explore(Skill):
             grid = onboard_grid(self.ctx, r)
             if self.p["seal_map_holes"]:
                 grid = sealed_grid(grid)
+            mob = r.mobility
+            below = 0.0 if mob.aerial else mob.body_height_m + grid.voxel_size_m
+            grid = mark_blocked_spots(grid, svc.blocked_spots, self.p["no_go_radius_m"],
+                                      below or self.p["no_go_radius_m"])
             res = self._call(svc, grid, bounds)
         except Exception as err:  # a failed planner call never crashes the tree
             detail = f"{type(err).__name__}: {err}"
@@ -315,11 +500,13 @@ class Explore(Skill):
             assert res.path is not None
             self.failures = 0
             self.follow(res.path)
-            self.following = True
+            self.following, self.path, self.rerouted = True, res.path, False
+            self.frontier = _frontier_of(res, svc.planner.global_planner.iteration)
             length = _length(res.path)
             self.feedback_message = f"{res.mode}: {length:.1f} m, gain {res.gain:.0f} m3"
             self.event("gbplanner_path", mode=res.mode, gain_m3=round(res.gain, 1), path_length_m=round(length, 2),
-                       to=_xyz(res.path[-1]), frontiers=len(svc.planner.global_planner.frontiers))
+                       to=_xyz(res.path[-1]), frontiers=len(svc.planner.global_planner.frontiers),
+                       **({"detail": res.reason} if res.reason else {}))
             return Status.RUNNING
         if code == "exploration_complete":
             self.bb.set(self.k_complete, True)
@@ -350,8 +537,8 @@ class Explore(Skill):
             for v in hidden:
                 del gp.frontiers[v]
         try:
-            return planner.plan(grid, r.position, svc.rng, yaw_rad=r.yaw_rad, endurance_remaining_s=endurance,
-                                exploration_bounds=bounds)
+            return planner.plan(grid, start_pose(grid, planner.config, r.position, self.p["start_shift_m"]), svc.rng,
+                                yaw_rad=r.yaw_rad, endurance_remaining_s=endurance, exploration_bounds=bounds)
         finally:
             gp.frontiers.update(hidden)
 
@@ -477,5 +664,6 @@ class Home(Skill):
         self.moving = False
 
 
-__all__ = ["PLAN_REASONS", "Explore", "Home", "PlannerService", "ShrinkingLocalPlanner", "gbplanner",
-           "onboard_grid", "parse_bbox", "plan_reason", "robot_config", "sealed_grid", "stable_seed"]
+__all__ = ["PLAN_REASONS", "Explore", "Home", "PlannerService", "ShrinkingLocalPlanner", "blocked_spot", "gbplanner",
+           "mark_blocked_spots", "onboard_grid", "parse_bbox", "plan_reason", "robot_config", "sealed_grid",
+           "stable_seed", "start_pose"]

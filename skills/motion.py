@@ -2,8 +2,9 @@
 (the CERBERUS behaviour tree's "Recovery Homing" and its WiFi-safety back-off)."""
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 from py_trees.common import Access, Status

@@ -19,8 +19,10 @@ class RobotStuck(Skill):
 
     Keeps the robot's positions over the last ``stuck_time_s`` while it follows a
     path. Returns SUCCESS (and logs a ``watchdog`` trigger) when it has followed a
-    path for ``stuck_time_s`` and moved less than ``min_motion_m`` in that time;
-    FAILURE otherwise.
+    path for ``stuck_time_s`` and every position in that time lies within
+    ``min_motion_m`` of where it is now (going away and back is motion); FAILURE
+    otherwise.
+
     """
 
     PARAMS = {
@@ -40,8 +42,9 @@ class RobotStuck(Skill):
         self.history.append((now, r.position))
         while len(self.history) > 1 and now - self.history[1][0] >= self.p["stuck_time_s"]:
             self.history.popleft()
-        t0, p0 = self.history[0]
-        if now - t0 >= self.p["stuck_time_s"] and np.linalg.norm(r.position - p0) < self.p["min_motion_m"]:
+        t0 = self.history[0][0]
+        spread = max(float(np.linalg.norm(r.position - p)) for _, p in self.history)
+        if now - t0 >= self.p["stuck_time_s"] and spread < self.p["min_motion_m"]:
             self.history.clear()
             self.feedback_message = f"no motion for {self.p['stuck_time_s']:.0f} s"
             self.event("watchdog", trigger=True, position=[round(float(v), 2) for v in r.position])

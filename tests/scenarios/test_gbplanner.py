@@ -7,10 +7,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-
-from delve import TREES_DIR
 from delve.executive.runner import Mission
 from delve.executive.scenario import load_scenario
+
+from delve import TREES_DIR
 
 BASE_TREE = str(TREES_DIR / "base_station.yaml")
 SMALL_TUNNEL = {"generator": "tunnel_network", "total_length_m": 120, "loops": 1}

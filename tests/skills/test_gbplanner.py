@@ -10,8 +10,19 @@ from delve.executive.errors import DelveError
 from delve.executive.tree_loader import build_tree, check_context
 from delve.planners.gbplanner2 import synthetic as syn
 from delve.planners.occupancy import FREE, OCCUPIED, UNKNOWN, Grid
-from delve.skills.gbplanner import (SERVICE, Explore, Home, ShrinkingLocalPlanner, gbplanner, parse_bbox,
-                                    robot_config, sealed_grid, stable_seed)
+from delve.skills.gbplanner import (
+    SERVICE,
+    Explore,
+    Home,
+    ShrinkingLocalPlanner,
+    blocked_spot,
+    gbplanner,
+    mark_blocked_spots,
+    parse_bbox,
+    robot_config,
+    sealed_grid,
+    stable_seed,
+)
 from py_trees.common import Status
 
 from .test_motion import FakeRobot, body, events, make_ctx, run
@@ -55,6 +66,7 @@ def test_robot_config_takes_the_platform_preset_and_the_robot_limits(half_mapped
     cfg = robot_config(legged)
     assert cfg.robot_type == "legged" and cfg.num_vertices_max == 1000 and cfg.sensor_fov_vertical_deg == 30.0
     assert cfg.max_inclination_deg == 35.0 and cfg.endurance_s == 1200.0 and cfg.clustering_radius_m == 0.0
+    assert cfg.robot_box_size_m[:2] == pytest.approx((0.6, 0.6))  # 0.8 m less a voxel: rounded out, 3 voxels
     aerial = FakeRobot(grid, body(a, 3.0), platform="aerial")
     cfg = robot_config(aerial, {"num_vertices_max": 300})
     assert cfg.robot_type == "aerial" and cfg.num_vertices_max == 300
@@ -171,11 +183,22 @@ def test_explore_fails_at_once_on_an_invalid_start(half_mapped):
     grid, a, _ = half_mapped
     robot = FakeRobot(grid, body(a, 8.0, 1.9))  # the robot box overlaps the tunnel wall
     ctx = make_ctx(robot)
-    node = explore(ctx)
+    node = explore(ctx, start_shift_m=0.0)
     node.tick_once()
     assert node.status == Status.FAILURE
     assert bb("last_plan_reason") == "invalid_start" and bb("planner_mode") == "none"
     assert events(ctx, "explore_failed")[0]["reason"] == "invalid_start"
+
+
+def test_explore_starts_from_a_clear_pose_next_to_a_wall(half_mapped):
+    grid, a, _ = half_mapped
+    robot = FakeRobot(grid, body(a, 8.0, 1.85))  # 0.15 m from the wall: the box touches it
+    ctx = make_ctx(robot)
+    node = explore(ctx)
+    node.tick_once()
+    assert node.status == Status.RUNNING and bb("last_plan_reason") == "ok"
+    start = robot.paths[0][0]
+    assert start[1] < robot.position[1] and np.linalg.norm(start - robot.position) <= 0.4 + 1e-9
 
 
 def test_a_planner_error_is_a_failure_with_its_reason(half_mapped):
@@ -213,6 +236,69 @@ def test_explore_retries_a_failed_iteration_then_fails(half_mapped):
     ctx.clock.now_s = 5.0
     node.tick_once()
     assert node.status == Status.FAILURE and len(events(ctx, "plan_failed")) == 2
+
+
+def test_blocked_paths_leave_rock_on_the_planners_map_then_fail(half_mapped):
+    grid, a, _ = half_mapped
+    robot = FakeRobot(grid, body(a, 8.0))
+    ctx = make_ctx(robot)
+    node = explore(ctx, max_blocked_paths=3, reroute_poses=0)
+    svc = gbplanner(ctx, robot, node.overrides)
+    statuses = []
+    for _ in range(3):
+        node.tick_once()
+        statuses.append(node.status)
+        robot.block_at, robot.block_radius_m = robot.position, 0.5  # every step is refused
+        robot.step(1.0)
+        robot.block_at = None
+    node.tick_once()
+    statuses.append(node.status)
+    assert statuses == [Status.RUNNING] * 3 + [Status.FAILURE]
+    assert bb("last_plan_reason") == "blocked"
+    blocked = events(ctx, "explore_path_blocked")
+    assert [e["in_a_row"] for e in blocked] == [1, 2, 3]
+    assert len(svc.blocked_spots) == 3
+    for spot in svc.blocked_spots:  # just ahead of the robot, where it could not go
+        assert 1.0 < np.linalg.norm((spot - robot.position)[:2]) < 1.2
+
+
+def test_a_blocked_path_is_rerouted_on_the_navigation_graph_once(half_mapped):
+    grid, a, _ = half_mapped
+    robot = FakeRobot(grid, body(a, 8.0))
+    ctx = make_ctx(robot)
+    node = explore(ctx)
+    node.tick_once()
+    planned = robot.paths[-1]
+    robot.block_at, robot.block_radius_m = robot.position, 0.5
+    robot.step(1.0)
+    robot.block_at = None
+    node.tick_once()  # blocked: the navigation graph's way to the farthest pose it reaches
+    assert node.status == Status.RUNNING and len(robot.paths) == 2
+    (rerouted,) = events(ctx, "explore_rerouted")
+    assert np.linalg.norm(np.array(rerouted["to"]) - planned[-1]) < 2.0
+    assert not events(ctx, "explore_path_blocked")
+    robot.block_at, robot.block_radius_m = robot.position, 0.5
+    robot.step(1.0)  # blocked again: now a blocked path for the planner
+    robot.block_at = None
+    node.tick_once()
+    assert len(events(ctx, "explore_path_blocked")) == 1 and len(events(ctx, "explore_rerouted")) == 1
+
+
+def test_blocked_spot_and_its_rock():
+    path = np.array([[0.0, 0.0, 1.5], [2.0, 0.0, 1.5], [2.0, 2.0, 1.5]])
+    assert np.allclose(blocked_spot(np.array([1.0, 0.0, 1.5]), path, 0.7), [1.7, 0.0, 1.5])
+    # At a corner: towards the next waypoint, not the one reached.
+    assert np.allclose(blocked_spot(np.array([2.0, 0.0, 1.5]), path, 0.7), [2.0, 0.7, 1.5])
+    assert blocked_spot(np.zeros(3), None, 0.7) is None
+    occ = np.zeros((20, 20, 15), np.int8)
+    grid = Grid(occ, np.zeros(3), 0.2)
+    out = mark_blocked_spots(grid, [np.array([2.0, 2.0, 1.5])], 0.3, 0.7)
+    rock = np.argwhere(out.occupancy == OCCUPIED)
+    assert len(rock) and grid.occupancy.max() == 0
+    centres = grid.to_world(rock)
+    assert np.all(np.hypot(centres[:, 0] - 2.0, centres[:, 1] - 2.0) <= 0.3 + 0.2)
+    assert centres[:, 2].min() >= 0.7 and centres[:, 2].max() <= 1.9 + 1e-9
+    assert mark_blocked_spots(grid, [], 0.3, 0.7) is grid
 
 
 def test_explore_stays_inside_the_exploration_box(half_mapped):
