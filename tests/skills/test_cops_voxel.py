@@ -1,0 +1,105 @@
+"""delve.skills.cops_voxel: the COPS network of a SimRobot's onboard map."""
+from __future__ import annotations
+
+import networkx as nx
+import numpy as np
+import pytest
+from delve.planners.cops.topology import Topology
+from delve.sim.platforms import AERIAL, LEGGED
+from delve.sim.radio import RadioNetwork, RadioSpec
+from delve.sim.robot import SimRobot
+from delve.sim.world import World
+from delve.sim.worldgen_geometry import VoxelCanvas, carve_tunnel, free_space_mesh
+from delve.skills.cops_voxel import VoxelNetworkView
+
+V = 0.2
+DT_S = 0.2          # one sim step, one sweep of the sensors
+
+
+@pytest.fixture(scope="module")
+def tunnel() -> World:
+    """A straight tunnel along x from 0 to 40 m, 4 m wide and 3 m high (cells c0..c4)."""
+    canvas = VoxelCanvas(np.array([0.0, 0.0, 0.0]), np.array([40.0, 8.0, 3.0]), V)
+    carve_tunnel(canvas, [0.5, 4.0, 0.0], [39.5, 4.0, 0.0], 4.0, 3.0)
+    mesh = free_space_mesh(canvas.free, canvas.origin, V)
+    return World(name="cops-voxel", voxel_size_m=V, origin=canvas.origin, free=canvas.free, mesh=mesh,
+                 start=[3.0, 4.0, 0.01])
+
+
+def robot_in(world: World, platform=LEGGED) -> SimRobot:
+    net = RadioNetwork(RadioSpec(), world, np.random.default_rng(0), lambda: 0.0)
+    holder: dict[str, SimRobot] = {}
+    radio = net.add("r1", lambda: holder["r"].position)
+    robot = holder["r"] = SimRobot("r1", platform, world, np.array([3.0, 4.0, 0.0]), radio)
+    return robot
+
+
+def walk(robot: SimRobot, to_x: float) -> None:
+    """Walk along the tunnel's axis to ``to_x``, scanning at every step."""
+    robot.scan()
+    robot.follow_path(np.array([[to_x, 4.0, robot.position[2]]]))
+    while robot.path_status == "following":
+        robot.step(DT_S)
+        robot.scan()
+
+
+@pytest.fixture(scope="module")
+def scanned(tunnel):
+    robot = robot_in(tunnel)
+    walk(robot, 13.0)
+    return robot, VoxelNetworkView(robot)
+
+
+def test_topology_of_a_scanned_tunnel(scanned):
+    _, view = scanned
+    topo = Topology.from_dict(view.topology())
+    assert {"c0_0_0", "c1_0_0"} <= set(topo.locations)
+    assert ("c0_0_0", "c1_0_0") in topo.mobility and ("c0_0_0", "c1_0_0") in topo.communication
+    g = nx.Graph(list(topo.mobility))
+    assert nx.is_connected(g)
+    assert topo.frontiers(), "the tunnel goes on beyond what the robot has mapped"
+    assert "c0_0_0" in topo.explored
+
+
+def test_location_is_the_robots_cell(scanned):
+    robot, view = scanned
+    assert view.location() == "c1_0_0"
+    ground = view.ground_point()
+    assert ground[2] == pytest.approx(robot.position[2] - LEGGED.body_height_m + 0.5 * V)
+
+
+def test_route_to_a_neighbouring_location(scanned):
+    robot, view = scanned
+    goal = np.array(view.current().locations["c0_0_0"])
+    path = view.route("c0_0_0")
+    assert path is not None and path.shape[1] == 3
+    assert np.linalg.norm(path[0] - robot.position) < 1.0
+    assert np.linalg.norm(path[-1][:2] - goal[:2]) < 0.5
+    assert path[-1][2] == pytest.approx(goal[2] + LEGGED.body_height_m - 0.5 * V)
+    assert view.route("c9_9_9") is None
+
+
+def test_extraction_is_cached_per_map_version(tunnel):
+    robot = robot_in(tunnel)
+    robot.scan()
+    view = VoxelNetworkView(robot)
+    first = view.topology()
+    assert view.topology() == first and view.location() is not None and view.extractions == 1
+    robot.scan()
+    view.topology()
+    assert view.extractions == 2
+
+
+def test_aerial_robot_flies_through_its_cells(tunnel):
+    robot = robot_in(tunnel, AERIAL)
+    walk(robot, 12.0)
+    view = VoxelNetworkView(robot)
+    topo = view.current()
+    assert view.location() == "c1_0_0" and ("c0_0_0", "c1_0_0") in topo.mobility
+    path = view.route("c0_0_0")
+    assert path is not None and np.linalg.norm(path[-1] - topo.locations["c0_0_0"]) < 1.0
+
+
+def test_bad_cell_size_is_refused(tunnel):
+    with pytest.raises(ValueError, match="cell_m"):
+        VoxelNetworkView(robot_in(tunnel), cell_m=0.0)
