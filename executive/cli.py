@@ -62,7 +62,7 @@ def main(argv: list[str] | None = None) -> int:
 def run(path: Path, out: Path | None, seed: int | None, duration_s: float | None, quiet: bool) -> int:
     """Run a scenario, write its outputs, print a summary; exit status per the mission."""
     from .outputs import write_outputs
-    from .runner import Mission
+    from .runner import create_mission
     from .scenario import load_scenario
 
     if seed is not None and seed < 0:
@@ -72,7 +72,7 @@ def run(path: Path, out: Path | None, seed: int | None, duration_s: float | None
     scenario = load_scenario(path)
     out = out or Path("delve-out") / scenario.name
     started = time.perf_counter()
-    mission = Mission(scenario, seed=seed, duration_s=duration_s)
+    mission = create_mission(scenario, seed=seed, duration_s=duration_s)
     if quiet:
         mission.run()
     else:

@@ -14,11 +14,12 @@ import numpy as np  # noqa: E402
 
 from ..planners.frontier import frontier_voxels  # noqa: E402
 from ..planners.occupancy import Grid  # noqa: E402
+from ..sim.graph_world import GraphWorld  # noqa: E402
 from .render import render_tree  # noqa: E402
 from .runner import Mission  # noqa: E402
 
 #: Report fields that depend on the wall clock; everything else is deterministic.
-WALL_CLOCK_FIELDS = ("wall_time_s", "real_time_factor")
+WALL_CLOCK_FIELDS = ("wall_time_s", "real_time_factor", "cops_solve_time_s")
 
 
 def report(mission: Mission, wall_time_s: float) -> dict[str, Any]:
@@ -42,6 +43,7 @@ def report(mission: Mission, wall_time_s: float) -> dict[str, Any]:
             "safety_triggers": dict(sorted(triggers[name].items())),
             "messages_sent": robot.radio.sent,
             "messages_undelivered": robot.radio.pending,
+            **mission.robot_figures(name),
         })
     sim_time = mission.finished_s or mission.clock.now_s
     return {
@@ -53,8 +55,9 @@ def report(mission: Mission, wall_time_s: float) -> dict[str, Any]:
         "real_time_factor": round(sim_time / wall_time_s, 1) if wall_time_s > 0 else None,
         "coverage_fraction": last.team,
         "base_coverage_fraction": last.base,
-        "free_volume_m3": round(len(mission.truth) * mission.world.voxel_size_m ** 3, 1),
+        **mission.world_figures(),
         "robots": robots,
+        **mission.wall_clock_figures(),
     }
 
 
@@ -71,8 +74,12 @@ def write_outputs(mission: Mission, out: Path, wall_time_s: float) -> dict[str, 
     with open(out / "log.jsonl", "w") as f:
         for e in mission.state.events:
             f.write(json.dumps(e, sort_keys=False) + "\n")
-    plot_map(mission, out / "map.png")
-    plot_coverage(mission, out / "coverage.png")
+    if isinstance(mission.world, GraphWorld):
+        plot_graph_map(mission, out / "map.png")
+        plot_coverage(mission, out / "coverage.png", "fraction of locations explored")
+    else:
+        plot_map(mission, out / "map.png")
+        plot_coverage(mission, out / "coverage.png")
     for name, agent in mission.agents.items():
         render_tree(agent.root, "txt", out / f"tree_{name}.txt")
         render_tree(agent.root, "svg", out / f"tree_{name}.svg")
@@ -123,8 +130,44 @@ def plot_map(mission: Mission, path: Path) -> None:
     plt.close(fig)
 
 
-def plot_coverage(mission: Mission, path: Path) -> None:
-    """Explored fraction of the free volume over sim time: team, base station, robots."""
+def plot_graph_map(mission: Mission, path: Path) -> None:
+    """A graph world from above: tunnels, communication edges, the locations the team
+    explored and those known at the base station, robot paths, the base station."""
+    world = mission.world
+    xyz = {s: world.pos(s) for s in world.graph.nodes}
+    span = np.ptp(np.array(list(xyz.values()))[:, :2], axis=0) + 1.0
+    fig, ax = plt.subplots(figsize=(9, min(max(9 * span[1] / span[0], 3.0), 12) + 0.8))
+    for u, v in sorted(world.communication):
+        ax.plot([xyz[u][0], xyz[v][0]], [xyz[u][1], xyz[v][1]], ":", lw=0.6, color="0.75")
+    for u, v in world.graph.edges:
+        ax.plot([xyz[u][0], xyz[v][0]], [xyz[u][1], xyz[v][1]], "-", lw=2.5, color="0.8", zorder=1)
+    team = set().union(*(r.explored for r in mission.robots.values()))
+    st = mission.base_state()
+    at_base = st.knowledge.topology.explored if st is not None else set()
+    for group, style, label in ((set(xyz) - team, dict(color="0.7", ms=4), "unexplored"),
+                                (team - at_base, dict(color="tab:orange", ms=6), "explored, not yet at base"),
+                                (team & at_base, dict(color="tab:blue", ms=6), "known at base station")):
+        pts = np.array([xyz[s] for s in sorted(group)]).reshape(-1, 3)
+        ax.plot(pts[:, 0], pts[:, 1], "o", label=label, zorder=2, **style)
+    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    for i, (name, robot) in enumerate(mission.robots.items()):
+        trail = robot.traversed_path
+        ax.plot(trail[:, 0], trail[:, 1], "-", lw=1, alpha=0.6, color=colours[i % len(colours)], zorder=3,
+                label=name if len(mission.robots) <= 10 else None)
+    ax.plot(*mission.base_position[:2], "k^", ms=10, label="base station", zorder=4)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    last = mission.state.samples[-1]
+    ax.set_title(f"{mission.scenario.name}: {last.team:.0%} of locations explored, {last.base:.0%} known at base")
+    ax.legend(loc="upper right", fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def plot_coverage(mission: Mission, path: Path, ylabel: str = "fraction of free volume observed") -> None:
+    """Explored fraction over sim time: team, base station, robots."""
     s = mission.state.samples
     t = np.array([x.t for x in s]) / 60.0
     fig, ax = plt.subplots(figsize=(7, 4))
@@ -134,7 +177,7 @@ def plot_coverage(mission: Mission, path: Path) -> None:
         for name in mission.robots:
             ax.plot(t, [x.robots[name] for x in s], lw=1, label=name)
     ax.set_xlabel("sim time (min)")
-    ax.set_ylabel("fraction of free volume observed")
+    ax.set_ylabel(ylabel)
     ax.set_ylim(0, 1.02)
     ax.grid(alpha=0.3)
     ax.legend()

@@ -53,6 +53,14 @@ class MissionState:
     samples: list[Sample] = field(default_factory=list)
 
 
+def create_mission(scenario: Scenario, **kw: Any) -> "Mission":
+    """The mission of a scenario: on a graph world (COPS) or a voxel world."""
+    if scenario.is_graph:
+        from .graph_mission import GraphMission
+        return GraphMission(scenario, **kw)
+    return Mission(scenario, **kw)
+
+
 class Mission:
     """A scenario made runnable: world, robots, radio, base station and agents."""
 
@@ -91,6 +99,7 @@ class Mission:
                                       on_change=self._status_changed)
         self._commands = deque(scenario.supervisor)
         self._faults = deque(scenario.faults)
+        self.lost: set[str] = set()
         reach = self.world.reachable_free(self._first_start())
         self.truth = np.flatnonzero(reach.reshape(-1))
         self.finished_s: float | None = None
@@ -120,6 +129,11 @@ class Mission:
         return free[index]
 
     def _context(self, name: str, robot: SimRobot | None) -> AgentContext:
+        """A fresh context for agent ``name``; what an earlier mission in this process
+        left under its blackboard namespace is cleared (py_trees' storage is global)."""
+        storage = py_trees.blackboard.Blackboard.storage
+        for key in [k for k in storage if k.startswith(f"/{name}/")]:
+            del storage[key]
         return AgentContext(name=name, namespace=f"/{name}", clock=self.clock, log=self.log, robot=robot)
 
     # ---- events -----------------------------------------------------------------
@@ -132,7 +146,12 @@ class Mission:
     # ---- running ----------------------------------------------------------------
     @property
     def robot_agents(self) -> list[Agent]:
-        return [a for n, a in self.agents.items() if n != BASE]
+        """The agents of the robots that were not lost (a ``lost`` fault)."""
+        return [a for n, a in self.agents.items() if n != BASE and n not in self.lost]
+
+    def _done(self) -> bool:
+        """Whether the mission is over: every robot's tree has finished (lost ones aside)."""
+        return all(a.finished for a in self.robot_agents)
 
     def run(self, progress: Callable[["Mission"], None] | None = None, progress_period_s: float = 10.0) -> None:
         """Run until every robot's tree has finished or ``duration_s`` has passed,
@@ -154,13 +173,13 @@ class Mission:
             if progress is not None and now + 1e-9 >= next_progress:
                 progress(self)
                 next_progress = now + progress_period_s
-            if all(a.finished for a in self.robot_agents) or now >= self.duration_s:
+            if self._done() or now >= self.duration_s:
                 break
             for robot in self.robots.values():
                 robot.step(self.clock.dt_s)
             self.clock.step()
         self.finished_s = self.clock.now_s
-        timed_out = not all(a.finished for a in self.robot_agents)
+        timed_out = not self._done()
         self.log("mission_end", timed_out=timed_out)
         for agent in self.robot_agents:
             if not agent.finished:
@@ -181,6 +200,10 @@ class Mission:
             robot = self.robots[f.robot]
             if f.kind == "stuck":
                 robot.jam(f.duration_s)
+            elif f.kind == "lost":
+                robot.kill()
+                self.agents[f.robot].stop()
+                self.lost.add(f.robot)
             else:
                 robot.inject_map_artifact()
             self.log("fault", robot=f.robot, kind=f.kind, duration_s=f.duration_s)
@@ -219,7 +242,19 @@ class Mission:
         ))
 
     # ---- results ----------------------------------------------------------------
+    def world_figures(self) -> dict[str, Any]:
+        """Report figures of the world kind (here: the reachable free volume)."""
+        return {"free_volume_m3": round(len(self.truth) * self.world.voxel_size_m ** 3, 1)}
+
+    def robot_figures(self, name: str) -> dict[str, Any]:
+        """Extra per-robot report figures of the world kind."""
+        return {"lost": name in self.lost} if self.lost else {}
+
+    def wall_clock_figures(self) -> dict[str, Any]:
+        """Report figures that depend on the wall clock."""
+        return {}
+
     @property
     def succeeded(self) -> bool:
-        """Every robot's tree ended in SUCCESS."""
+        """Every robot's tree ended in SUCCESS (robots lost to a fault aside)."""
         return all(a.root.status == Status.SUCCESS for a in self.robot_agents)

@@ -15,6 +15,8 @@ from typing import Any
 import jsonschema
 
 from ..sim import worldgen
+from ..sim.graph_world import GraphWorld
+from . import graph_worlds
 from ..sim.world import World
 from .errors import DelveError, did_you_mean
 from .supervisor import Command, load_supervisor
@@ -22,7 +24,9 @@ from .supervisor import Command, load_supervisor
 from .yamlio import YamlDict, YamlList, load_yaml, plain
 
 SCHEMA_PATH = Path(__file__).parent / "schema" / "scenario.schema.json"
-GENERATORS = ("tunnel_network", "cave")
+GENERATORS = ("tunnel_network", "cave") + graph_worlds.GRAPH_GENERATORS
+#: Radio settings that mean something on a graph world (communication edges decide links).
+GRAPH_RADIO_KEYS = ("loss", "update_period_s")
 MESH_OPTIONS = ("mesh", "scale", "up_axis", "voxel_size_m", "start", "seed")
 DEFAULTS = {"seed": 0, "duration_s": 3600.0, "dt_s": 0.1, "coverage_period_s": 5.0}
 
@@ -52,8 +56,9 @@ class RobotSpec:
 @dataclass(frozen=True)
 class Fault:
     """A fault injected at ``at_s``: ``stuck`` (the robot cannot move for
-    ``duration_s``) or ``map_artifact`` (rock appears in its onboard map around it,
-    as odometry drift leaves in a real map)."""
+    ``duration_s``), ``map_artifact`` (rock appears in its onboard map around it,
+    as odometry drift leaves in a real map) or ``lost`` (the robot dies: it stops
+    and its radio falls silent for good)."""
 
     at_s: float
     robot: str
@@ -81,13 +86,24 @@ class Scenario:
     supervisor: list[Command] = field(default_factory=list)
     faults: list[Fault] = field(default_factory=list)
 
-    def build_world(self, seed: int | None = None) -> World:
+    @property
+    def is_graph(self) -> bool:
+        """Whether the world is a graph world (a network file or a graph generator)."""
+        return "network" in self.world or self.world.get("generator") in graph_worlds.GRAPH_GENERATORS
+
+    def build_world(self, seed: int | None = None) -> World | GraphWorld:
         """Generate or load the world (a DelveError when its parameters are wrong).
 
         A generator without its own ``seed`` takes ``seed``, else the scenario's."""
         spec = dict(self.world)
         line = self.doc["world"].line
         try:
+            if "network" in spec:
+                return graph_worlds.load_network_world(self.path.parent / spec["network"])
+            if spec.get("generator") in graph_worlds.GRAPH_GENERATORS:
+                gen = getattr(graph_worlds, spec.pop("generator"))
+                spec.setdefault("seed", self.seed if seed is None else seed)
+                return gen(**spec)
             if "mesh" in spec:
                 mesh = (self.path.parent / spec.pop("mesh")).resolve()
                 if not mesh.exists():
@@ -134,7 +150,7 @@ def _schema_error(err: jsonschema.ValidationError, doc: Any, path: Path) -> Delv
     if err.validator == "required":
         return DelveError(f"{where}: {err.message.replace(' is a required property', '')} is missing", path, line)
     if err.validator == "oneOf" and where == "world":
-        return DelveError("world: give either 'generator' or 'mesh'", path, line)
+        return DelveError("world: give one of 'generator', 'mesh' or 'network'", path, line)
     if err.validator == "enum":
         choices = ", ".join(map(repr, err.validator_value))
         return DelveError(f"{where}: {err.instance!r} is not one of {choices}", path, line)
@@ -154,12 +170,37 @@ def _nan(doc: Any, path: Path) -> None:
 def _world_params(world: YamlDict, path: Path) -> None:
     if "mesh" in world:
         allowed = MESH_OPTIONS
+    elif "network" in world:
+        allowed = ("network",)
     else:
-        allowed = ("generator",) + tuple(inspect.signature(getattr(worldgen, world["generator"])).parameters)
+        module = graph_worlds if world["generator"] in graph_worlds.GRAPH_GENERATORS else worldgen
+        allowed = ("generator",) + tuple(inspect.signature(getattr(module, world["generator"])).parameters)
     for key in world:
         if key not in allowed:
             raise DelveError(f"world: unknown parameter {key!r}{did_you_mean(key, allowed)}", path,
                              world.key_line(key))
+
+
+def _graph_checks(doc: YamlDict, path: Path, base_tree: Path | None, faults: list[Fault]) -> None:
+    """What a graph world needs and refuses: a base station tree, a readable network
+    file, no voxel-world radio settings or faults."""
+    world = doc["world"]
+    if "network" in world:
+        net_path = path.parent / world["network"]
+        if not net_path.exists():
+            raise DelveError(f"network file not found: {world['network']}", path, world.key_line("network"))
+        graph_worlds.load_network_world(net_path)
+    if base_tree is None:
+        raise DelveError("a graph world needs a base station tree (base_station: tree: ...), the COPS leader",
+                         path, doc.key_line("base_station") or doc.key_line("world"))
+    for key in doc.get("radio", {}):
+        if key not in GRAPH_RADIO_KEYS:
+            raise DelveError(f"radio: {key!r} does not apply to a graph world (communication edges decide links; "
+                             f"use {', '.join(GRAPH_RADIO_KEYS)})", path, doc["radio"].key_line(key))
+    for i, f in enumerate(faults):
+        if f.kind == "map_artifact":
+            raise DelveError("a 'map_artifact' fault needs a voxel map; a graph world has none", path,
+                             doc["faults"].item_line(i))
 
 
 def load_scenario(path: str | Path) -> Scenario:
@@ -210,6 +251,8 @@ def load_scenario(path: str | Path) -> Scenario:
             raise DelveError("a 'stuck' fault needs duration_s", path, doc["faults"].item_line(i))
         faults.append(Fault(float(f["at_s"]), f["robot"], f["kind"], float(f.get("duration_s", 0.0))))
     values = {k: doc.get(k, v) for k, v in DEFAULTS.items()}
+    if "network" in doc["world"] or doc["world"].get("generator") in graph_worlds.GRAPH_GENERATORS:
+        _graph_checks(doc, path, base_tree, faults)
     return Scenario(path=path, name=doc["name"], seed=int(values["seed"]), duration_s=float(values["duration_s"]),
                     dt_s=float(values["dt_s"]), coverage_period_s=float(values["coverage_period_s"]),
                     world=plain(doc["world"]), robots=robots, base_tree=base_tree,

@@ -242,8 +242,11 @@ class RadioEndpoint:
         self.breadcrumbs = int(breadcrumbs)
         self.breadcrumbs_deployed = 0
         self.relay = bool(relay)
+        self.silent = False
 
     def send(self, recipient: str, kind: str, data: Any) -> None:
+        if self.silent:
+            return
         self.outbox.append(Message(self.name, recipient, kind, data, self._net.now_s()))
         self.sent += 1
 
@@ -339,8 +342,9 @@ class RadioNetwork:
                 if now - b.deployed_s < self.spec.breadcrumb_battery_s]
 
     def node_positions(self) -> dict[str, np.ndarray]:
-        """Current positions of every node (endpoints, then active breadcrumbs)."""
-        pos = {n: np.asarray(self._positions[n](), dtype=float).reshape(3) for n in sorted(self.endpoints)}
+        """Current positions of every node (endpoints that are not silent, then active breadcrumbs)."""
+        pos = {n: np.asarray(self._positions[n](), dtype=float).reshape(3) for n in sorted(self.endpoints)
+               if not self.endpoints[n].silent}
         pos.update({b.name: b.position.copy() for b in self.active_breadcrumbs()})
         return pos
 

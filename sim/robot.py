@@ -178,6 +178,12 @@ class SimRobot:
         followed stays FOLLOWING but the robot does not move."""
         self._stuck_s = max(self._stuck_s, duration_s)
 
+    def kill(self) -> None:
+        """A fault: the robot dies where it stands; it stops and its radio falls silent."""
+        self.stop()
+        self._endurance = 0.0
+        self._radio.silent = True
+
     def inject_map_artifact(self, radius_m: float = 1.5) -> None:
         """A fault: the state estimator jumps, the robot halts, and rock appears in its
         onboard map all around it, as odometry drift leaves in a real map, so planners

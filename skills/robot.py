@@ -246,3 +246,21 @@ class Robot(Protocol):
     @property
     def payload(self) -> Payload | None:
         """The pan-tilt-zoom inspection camera; None when the robot carries none."""
+
+
+class NetworkView(Protocol):
+    """A robot's view of the COPS mobility-communication network.
+
+    ``topology()`` is the plain-dict form of
+    :class:`delve.planners.cops.topology.Topology`: every location the robot's own
+    sensing has revealed so far, the explored ones, and the edges it observed.
+    Location names must be the same for every robot that sees a location (the graph
+    world names them; a voxel world names lattice cells by their indices)."""
+
+    def topology(self) -> dict[str, Any]: ...
+
+    def location(self) -> str | None:
+        """The location the robot stands at, or None between locations."""
+
+    def route(self, location: str) -> np.ndarray | None:
+        """Waypoints (N x 3) from the robot to a known ``location``, None if no route."""

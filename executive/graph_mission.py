@@ -1,0 +1,156 @@
+"""Missions on graph worlds (COPS): robots on a network of locations, the base
+station as the COPS leader, a datagram radio over communication edges.
+
+The loop, events and outputs are the voxel mission's (:class:`Mission`); what
+differs is the world, the robots, the radio and the figures: coverage is the
+fraction of locations explored, and the report adds the COPS plans.
+"""
+from __future__ import annotations
+
+import statistics
+from collections import deque
+from dataclasses import replace
+from typing import Any
+
+import numpy as np
+import py_trees
+from py_trees.common import Status
+
+from ..sim.clock import SimClock
+from ..sim.graph_world import GraphRadioNetwork, GraphRadioSpec, GraphRobot, GraphWorld
+from ..sim.platforms import PLATFORMS
+from .agent import Agent
+from .runner import BASE, Mission, MissionState, Sample
+from .scenario import Scenario
+from .tree_loader import load_tree
+
+#: Blackboard key of the base station's COPS state (skills.cops.CopsState).
+BASE_STATE_KEY = f"/{BASE}/cops"
+
+
+class GraphMission(Mission):
+    """A scenario on a :class:`GraphWorld`."""
+
+    def __init__(self, scenario: Scenario, *, seed: int | None = None, duration_s: float | None = None,
+                 world: GraphWorld | None = None):
+        self.scenario = scenario
+        self.seed = scenario.seed if seed is None else seed
+        self.duration_s = scenario.duration_s if duration_s is None else duration_s
+        self.world = world if world is not None else scenario.build_world(seed=self.seed)
+        scenario.check_starts(self.world)
+        self.clock = SimClock(scenario.dt_s)
+        self.state = MissionState()
+        self.radio = GraphRadioNetwork(GraphRadioSpec(**scenario.radio), self.world,
+                                       np.random.default_rng(self.seed), lambda: self.clock.now_s)
+        self.robots: dict[str, GraphRobot] = {}
+        for spec in scenario.robots:
+            platform = PLATFORMS[spec.platform]
+            start = np.asarray(spec.start, float) if spec.start is not None else self.world.start
+            holder: dict[str, GraphRobot] = {}
+            radio = self.radio.add(spec.name, lambda h=holder: h["r"].position)
+            holder["r"] = self.robots[spec.name] = GraphRobot(
+                spec.name, replace(platform, **spec.overrides), self.world,
+                start, radio, spec.endurance_s)
+        base_pos = (np.asarray(scenario.base_position, float) if scenario.base_position is not None
+                    else self.world.start)
+        self.base_position = base_pos
+        base_radio = self.radio.add(BASE, lambda: base_pos)
+        self.base_location = self.world.location_at(base_pos)
+        team = {n: self.world.location_at(r.position) for n, r in self.robots.items()}
+        self.agents: dict[str, Agent] = {}
+        for spec in scenario.robots:
+            ctx = self._context(spec.name, self.robots[spec.name])
+            ctx.services.update(team=team, base_location=self.base_location)
+            self.agents[spec.name] = Agent(spec.name, load_tree(spec.tree, ctx), 1.0 / spec.tick_hz, ctx,
+                                           on_change=self._status_changed)
+        ctx = self._context(BASE, None)
+        ctx.services.update(radio=base_radio, team=team, base_location=self.base_location,
+                            initial_topology=self.world.explored_topology([self.base_location]))
+        self.agents[BASE] = Agent(BASE, load_tree(scenario.base_tree, ctx), 1.0 / scenario.base_tick_hz, ctx,
+                                  on_change=self._status_changed)
+        self._commands = deque(scenario.supervisor)
+        self._faults = deque(scenario.faults)
+        self.lost: set[str] = set()
+        self.truth = np.arange(len(self.world))
+        self.finished_s: float | None = None
+
+    # ---- the loop's hooks ---------------------------------------------------------
+    def _done(self) -> bool:
+        """Over when the base station's tree has finished and every robot's too (lost
+        robots aside), or as soon as the base station fails (no plan)."""
+        base = self.agents[BASE]
+        if base.root.status == Status.FAILURE:
+            return True
+        stranded = set(self.stranded)
+        return base.finished and all(a.finished or a.name in stranded for a in self.robot_agents)
+
+    @property
+    def stranded(self) -> list[str]:
+        """Robots the final plan (the recall) could not reach."""
+        st = self.base_state()
+        return list(st.plan.meta.get("stranded", ())) if st is not None and st.final and st.plan else []
+
+    def _sense(self, now: float) -> None:
+        """Robots explore as they arrive at locations (in ``GraphRobot.step``)."""
+
+    def base_state(self) -> Any:
+        """The base station's COPS state (None before its first tick)."""
+        return py_trees.blackboard.Blackboard.storage.get(BASE_STATE_KEY)
+
+    def _sample(self, now: float) -> None:
+        n = len(self.world)
+        team: set[str] = set()
+        per_robot = {}
+        for name, robot in self.robots.items():
+            team |= set(robot.explored)
+            per_robot[name] = round(len(robot.explored) / n, 5)
+        st = self.base_state()
+        base = len(st.knowledge.topology.explored) / n if st is not None else 0.0
+        self.state.samples.append(Sample(
+            t=now, team=round(len(team) / n, 5), base=round(base, 5), robots=per_robot,
+            positions={k: [round(float(v), 3) for v in r.position] for k, r in self.robots.items()},
+            linked={k: self.radio.linked(k, BASE) for k in self.robots}))
+
+    @property
+    def succeeded(self) -> bool:
+        return super().succeeded and self.agents[BASE].root.status == Status.SUCCESS
+
+    # ---- figures --------------------------------------------------------------------
+    def world_figures(self) -> dict[str, Any]:
+        """The report's graph-world figures: locations and the COPS plans."""
+        plans = [e for e in self.state.events if e["event"] == "cops_plan"]
+        base_done = next((s.t for s in self.state.samples if s.base >= 1.0), None)
+        st = self.base_state()
+        return {
+            "locations": len(self.world),
+            "locations_explored": len(set().union(*(r.explored for r in self.robots.values()))),
+            "locations_known_at_base": len(st.knowledge.topology.explored) if st is not None else 0,
+            "all_known_at_base_s": base_done,
+            "lost_robots": sorted(self.lost),
+            "stranded_robots": self.stranded,
+            "declared_lost": sorted({e["robot"] for e in self.state.events if e["event"] == "robot_declared_lost"}),
+            "cops": {
+                "cycles": len(plans),
+                "plans_valid": sum(1 for e in plans if e.get("valid")),
+                "no_plan": [e["reason"] for e in self.state.events if e["event"] in ("cops_no_plan",
+                                                                                      "cops_invalid_plan")],
+                "plans": [{k: e[k] for k in ("cycle", "final", "robots", "locations", "frontiers", "explorers",
+                                             "T_pre", "T_post", "ext_com", "int_com", "transitions", "relayed", "clustered")}
+                          for e in plans],
+            },
+        }
+
+    def wall_clock_figures(self) -> dict[str, Any]:
+        """Solve times of the COPS plans (wall clock, so left out of comparisons)."""
+        times = [e["solve_time_s"] for e in self.state.events if e["event"] == "cops_plan"
+                 and e.get("solve_time_s") is not None]
+        if not times:
+            return {}
+        return {"cops_solve_time_s": {"median": round(statistics.median(times), 3),
+                                      "max": round(max(times), 3), "total": round(sum(times), 3)}}
+
+    def robot_figures(self, name: str) -> dict[str, Any]:
+        robot = self.robots[name]
+        return {"transitions": robot.transitions, "locations_explored": len(robot.explored),
+                "lost": name in self.lost, "messages_dropped": robot.radio.dropped}
+

@@ -1,0 +1,71 @@
+"""The recall: the last plan of a mission, when no frontier is left.
+
+Every robot that m can reach (robots move only once they hold m, so m travels over
+communication edges and with robots that already hold it) is brought to the base.
+It is a reward problem like Problem 1: each robot holding m at the base at T earns
+``home_reward``, minus the plan's cost C(Π). The horizon is the smallest at which
+as many robots get home as at the largest horizon tried.
+"""
+from __future__ import annotations
+
+from typing import Iterable, Mapping
+
+from .ilp import ConnectivityProblem, InfeasibleProblem, SolverOptions, SolverTimeout, solve_connectivity
+from .network import MCNetwork
+from .plan import MASTER, Communication, Plan, idle_plan
+
+#: Reward for each robot brought home; larger than any route's mobility cost.
+DEFAULT_HOME_REWARD = 1000.0
+
+
+def solve_recall(network: MCNetwork, *, positions: Mapping[str, str], masters: Iterable[str],
+                 static: Iterable[str] = (), max_horizon: int | None = None,
+                 home_reward: float = DEFAULT_HOME_REWARD, options: SolverOptions | None = None) -> Plan:
+    """An information-consistent plan that brings home every robot m can reach, at
+    least cost; ``plan.meta["stranded"]`` lists the robots it cannot reach."""
+    base = network.base
+    if base is None:
+        raise ValueError("the recall needs a base location")
+    ms, st = set(masters), set(static)
+    mobile = sorted(r for r in positions if r not in st)
+    hops = network.hop_distances(base)
+    away = [r for r in mobile if positions[r] != base]
+    if not away:  # everyone is home: m is handed to each robot there, and that is all
+        plan = idle_plan(positions, ms, "recall")
+        giver = sorted(ms)[0]
+        plan.communications = [Communication(0, giver, r, MASTER) for r in mobile if r not in ms]
+        plan.meta["stranded"] = []
+        return plan
+    for r in away:
+        if positions[r] not in hops:
+            raise InfeasibleProblem(f"no route to the base for robot {r}")
+    upper = max_horizon if max_horizon is not None else 2 * max(hops[positions[r]] for r in away) + 2
+    opts = options or SolverOptions()
+
+    def solve(T: int) -> Plan | None:
+        problem = ConnectivityProblem(network=network, horizon=T, positions=dict(positions), masters=ms, static=st,
+                                      explorers=set(mobile), reward_robots=set(mobile),
+                                      location_rewards={base: (home_reward,) * len(mobile)}, phase="recall",
+                                      options=opts)
+        try:
+            return solve_connectivity(problem)
+        except SolverTimeout:
+            return None
+
+    def home(plan: Plan | None) -> int:
+        return -1 if plan is None else sum(1 for r in mobile if plan.location(r, plan.horizon) == base)
+
+    best = solve(upper)
+    if best is None:
+        raise InfeasibleProblem(f"no recall plan within horizon T={upper}")
+    lo, hi = 0, upper  # the smallest horizon that brings as many home
+    while lo < hi:
+        mid = (lo + hi) // 2
+        plan = solve(mid)
+        if home(plan) >= home(best):
+            best, hi = plan, mid
+        else:
+            lo = mid + 1
+    best.meta["stranded"] = sorted(r for r in mobile if best.location(r, best.horizon) != base)
+    best.explore = {}
+    return best

@@ -1,0 +1,162 @@
+"""What robots know of the mobility-communication network: a mergeable topology.
+
+A :class:`Topology` is the information a robot gathers and carries (the COPS
+paper's "extensions" of the network). It holds every location the robot has seen
+(with its position), the ones it has *explored* (visited, or fully mapped), and the
+mobility and communication edges it observed. Merging two topologies is a union,
+so the base station merges what comes back in any order.
+
+:meth:`Topology.network` turns it into the planning network N: the explored
+locations with the edges among them; a frontier is an explored location with a
+mobility edge to a location nobody has explored yet.
+
+Plain data: the dict form (``to_dict`` / ``from_dict``) is what robots send over
+the radio and what the simulator's graph world reports.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any, Iterable, Mapping
+
+from .network import DEFAULT_COMMUNICATION_COST, MCNetwork, Robot
+
+
+def _pair(u: str, v: str) -> tuple[str, str]:
+    return (u, v) if u <= v else (v, u)
+
+
+@dataclass
+class Topology:
+    """Locations (name -> position), explored locations and undirected edges.
+
+    ``mobility`` maps an edge (u, v), u < v, to its length in metres."""
+
+    locations: dict[str, tuple[float, float, float]] = field(default_factory=dict)
+    explored: set[str] = field(default_factory=set)
+    mobility: dict[tuple[str, str], float] = field(default_factory=dict)
+    communication: set[tuple[str, str]] = field(default_factory=set)
+
+    # -- building -------------------------------------------------------------------
+    def add_location(self, name: str, pos: Iterable[float], explored: bool = False) -> None:
+        p = tuple(float(c) for c in pos)
+        if len(p) != 3 or not all(math.isfinite(c) for c in p):
+            raise ValueError(f"location '{name}' needs a finite (x, y, z) position, got {p}")
+        self.locations.setdefault(name, p)
+        if explored:
+            self.explored.add(name)
+
+    def add_mobility_edge(self, u: str, v: str, length_m: float | None = None) -> None:
+        for s in (u, v):
+            if s not in self.locations:
+                raise ValueError(f"mobility edge {u}-{v} names unknown location '{s}'")
+        if u == v:
+            raise ValueError(f"mobility edge {u}-{v} is a self-loop")
+        if length_m is None:
+            length_m = math.dist(self.locations[u], self.locations[v])
+        self.mobility[_pair(u, v)] = float(length_m)
+
+    def add_communication_edge(self, u: str, v: str) -> None:
+        if u != v:
+            self.communication.add(_pair(u, v))
+
+    def merge(self, other: "Topology") -> bool:
+        """Add everything ``other`` knows; True when something was new."""
+        before = self.size()
+        for name, pos in other.locations.items():
+            self.locations.setdefault(name, pos)
+        self.explored |= other.explored
+        for e, length in other.mobility.items():
+            self.mobility.setdefault(e, length)
+        self.communication |= other.communication
+        return self.size() != before
+
+    def copy(self) -> "Topology":
+        return Topology(dict(self.locations), set(self.explored), dict(self.mobility), set(self.communication))
+
+    def size(self) -> tuple[int, int, int, int]:
+        return len(self.locations), len(self.explored), len(self.mobility), len(self.communication)
+
+    # -- queries ----------------------------------------------------------------------
+    def neighbours(self, location: str) -> list[str]:
+        """Mobility neighbours of ``location`` (explored or not), sorted by name."""
+        out = [v if u == location else u for u, v in self.mobility if location in (u, v)]
+        return sorted(out)
+
+    def frontiers(self) -> set[str]:
+        """Explored locations with a mobility edge to a location nobody explored."""
+        out = set()
+        for u, v in self.mobility:
+            if (u in self.explored) != (v in self.explored):
+                out.add(u if u in self.explored else v)
+        return out
+
+    def unexplored_exits(self, location: str) -> list[str]:
+        return [n for n in self.neighbours(location) if n not in self.explored]
+
+    def network(self, base: str, *, spacing_m: float | None = None,
+                communication_cost: float = DEFAULT_COMMUNICATION_COST) -> MCNetwork:
+        """The planning network N over the explored locations (``base`` must be one).
+
+        A move's mobility cost is its length over ``spacing_m`` (1 per move without
+        it), so that costs count time steps of roughly equal duration."""
+        if base not in self.explored:
+            raise ValueError(f"base location '{base}' has not been explored")
+        net = MCNetwork(base=base)
+        for s in sorted(self.explored):
+            net.add_location(s, self.locations[s], frontier=False)
+        for (u, v), length in sorted(self.mobility.items()):
+            if u in self.explored and v in self.explored:
+                cost = 1.0 if not spacing_m else round(max(length / spacing_m, 1e-3), 6)
+                net.add_mobility_edge(u, v, cost=cost, length_m=length)
+        for u, v in sorted(self.communication):
+            if u in self.explored and v in self.explored:
+                net.add_communication_edge(u, v, cost=communication_cost)
+        net.frontiers = self.frontiers()
+        return net
+
+    # -- plain data --------------------------------------------------------------------
+    def to_dict(self) -> dict[str, Any]:
+        return {"locations": {s: list(p) for s, p in sorted(self.locations.items())},
+                "explored": sorted(self.explored),
+                "mobility": [[u, v, round(length, 3)] for (u, v), length in sorted(self.mobility.items())],
+                "communication": [list(e) for e in sorted(self.communication)]}
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> "Topology":
+        """Read the dict form; a ``ValueError`` names the first malformed entry."""
+        topo = cls()
+        try:
+            for name, pos in d.get("locations", {}).items():
+                topo.add_location(str(name), pos)
+            for s in d.get("explored", []):
+                if s not in topo.locations:
+                    raise ValueError(f"explored location '{s}' is not a location")
+                topo.explored.add(str(s))
+            for e in d.get("mobility", []):
+                topo.add_mobility_edge(str(e[0]), str(e[1]), float(e[2]) if len(e) > 2 else None)
+            for u, v in d.get("communication", []):
+                for s in (u, v):
+                    if s not in topo.locations:
+                        raise ValueError(f"communication edge {u}-{v} names unknown location '{s}'")
+                topo.add_communication_edge(str(u), str(v))
+        except (TypeError, IndexError, AttributeError) as err:
+            raise ValueError(f"malformed topology: {err}") from None
+        return topo
+
+
+def team_network(topology: Topology, base: str, base_station: str, positions: Mapping[str, str], *,
+                 explorers: Iterable[str] | None = None, spacing_m: float | None = None) -> MCNetwork:
+    """The planning network with the team placed on it: the base station static at
+    ``base``, every other robot at its location in ``positions``."""
+    net = topology.network(base, spacing_m=spacing_m)
+    net.add_robot(Robot(base_station, base, static=True, explorer=False), base_station=True)
+    ex = None if explorers is None else set(explorers)
+    for r in sorted(positions):
+        if r == base_station:
+            continue
+        if positions[r] not in net:
+            raise ValueError(f"robot '{r}' is at '{positions[r]}', which is not an explored location")
+        net.add_robot(Robot(r, positions[r], explorer=ex is None or r in ex))
+    net.check()
+    return net

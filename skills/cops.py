@@ -1,0 +1,740 @@
+"""The COPS mission executive (Figure 4 of the COPS paper) as behaviours.
+
+Every agent (robots and the base station) keeps one :class:`CopsState` on its
+blackboard (key ``cops``): what it knows (the topology it gathered or received,
+the freshness of each robot's information, robots declared lost), the cycle plan it
+executes (the information m), which part of the cycle it is in (``pre``,
+``explore``, ``post``, ``done``) and the plan step t.
+
+Behaviours, in the paper's words:
+
+* ``InformationStorage``: background; receives, acknowledges and stores every
+  message, merges what the robot's own sensing reveals.
+* ``Leader?`` (``IsLeader``), ``COPS`` (``SolveCOPS``), ``WaitToReceivePlan``.
+* ``Explore?`` (``IsExploring``), ``ExplorationAction`` (Algorithm 1),
+  ``ExplorationTimer``, ``TransitToReturnNode``.
+* ``CommunicationAction`` (PreIntCom, ExtCom, PostIntCom; re-sent until
+  acknowledged), ``TransitionAction`` and ``ActionTimer``.
+* ``FinishedPlan?`` (``FinishedPlan``) and ``MissionComplete``.
+
+Messages (radio kind ``cops``) are ``{"type": "info" | "ack" | "hello", ...}``. An
+info message carries one plan communication (t, r, r', b) of one part of one
+cycle; its payload is the sender's whole knowledge (topology, information
+freshness, lost robots) and, for b = m, the cycle plan.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from py_trees.common import Status
+
+from ..planners.cops import (MASTER, Communication, CyclePlan, PlanningError, SolverOptions, plan_cycle,
+                             solve_post_exploration, validate_plan)
+from ..planners.cops.plan import Plan, idle_plan
+from ..planners.cops.recall import solve_recall
+from ..planners.cops.topology import Topology, team_network
+from .base import AgentContext, Param, Skill
+
+KIND = "cops"
+PARTS = ("pre", "explore", "post", "done")
+STATE_KEY = Param(str, "cops", "blackboard key of the agent's COPS state", key=True)
+
+
+@dataclass
+class Knowledge:
+    """What an agent holds (the paper's information storage).
+
+    ``freshness[r]``: newest cycle whose information of robot r this agent holds.
+    ``received`` / ``acked``: ids of info messages received / acknowledged to us.
+    ``heard[r]``: newest sim time r was heard from (by anyone whose knowledge we have);
+    ``declared[r]``: newest time r was declared lost. r counts as lost while it was
+    declared lost after it was last heard from."""
+
+    topology: Topology = field(default_factory=Topology)
+    freshness: dict[str, int] = field(default_factory=dict)
+    declared: dict[str, float] = field(default_factory=dict)
+    received: set[str] = field(default_factory=set)
+    acked: set[str] = field(default_factory=set)
+    heard: dict[str, float] = field(default_factory=dict)
+    pending_plan: dict[str, Any] | None = None
+
+    @property
+    def lost(self) -> set[str]:
+        return {r for r, t in self.declared.items() if t > self.heard.get(r, -math.inf)}
+
+    def payload(self) -> dict[str, Any]:
+        return {"topology": self.topology.to_dict(), "freshness": dict(self.freshness),
+                "declared": dict(self.declared), "heard": dict(self.heard)}
+
+    def absorb(self, payload: dict[str, Any]) -> None:
+        self.topology.merge(Topology.from_dict(payload["topology"]))
+        for mine, theirs in ((self.freshness, payload["freshness"]), (self.declared, payload["declared"]),
+                             (self.heard, payload["heard"])):
+            for r, v in theirs.items():
+                mine[r] = max(mine.get(r, -math.inf), v)
+
+
+@dataclass
+class CopsState:
+    """An agent's COPS state (blackboard key ``cops``)."""
+
+    knowledge: Knowledge = field(default_factory=Knowledge)
+    cycle: int = -1
+    plan: CyclePlan | None = None
+    part: str = "done"
+    step: int = 0
+    final: bool = False
+    delta_t_s: float = 60.0
+    lost_timeout_s: float = 1200.0
+    recall_after_s: float = 1800.0
+    base_location: str | None = None
+    explored_in: dict[str, int] = field(default_factory=dict)
+
+    def part_plan(self) -> Plan | None:
+        if self.plan is None:
+            return None
+        return {"pre": self.plan.pre, "post": self.plan.post}.get(self.part)
+
+    def adopt(self, msg: dict[str, Any]) -> None:
+        """Take the cycle plan m of ``msg`` and continue from the step it arrived at."""
+        m = msg["plan"]
+        self.plan = CyclePlan.from_dict(m["cycle"])
+        self.cycle, self.final = int(msg["cycle"]), bool(m["final"])
+        self.delta_t_s, self.lost_timeout_s = float(m["delta_t_s"]), float(m["lost_timeout_s"])
+        self.recall_after_s = float(m["recall_after_s"])
+        self.base_location = m["base_location"]
+        self.part, self.step = msg["part"], int(msg["t"])
+
+
+def message_id(cycle: int, part: str, c: Communication) -> str:
+    return f"{cycle}:{part}:{c.t}:{c.sender}>{c.receiver}:{c.info}"
+
+
+def network_view(ctx: AgentContext) -> Any:
+    """The robot's NetworkView: a service, the robot itself, or its voxel map."""
+    view = ctx.services.get("network_view")
+    if view is None and ctx.robot is not None:
+        if hasattr(ctx.robot, "topology"):
+            view = ctx.robot
+        else:
+            from .cops_voxel import VoxelNetworkView
+            view = VoxelNetworkView(ctx.robot)
+        ctx.services["network_view"] = view
+    return view
+
+
+class CopsSkill(Skill):
+    """Base of the COPS behaviours: the agent's state and radio."""
+
+    ABSTRACT = True
+    PARAMS = {"state": STATE_KEY}
+
+    def __init__(self, name: str, ctx: AgentContext, remap: dict[str, str] | None = None, **params: Any):
+        super().__init__(name, ctx, remap, **params)
+        self._state_key = self.key(self.p["state"])
+
+    @property
+    def state(self) -> CopsState:
+        st = self.get(self._state_key)
+        if st is None:
+            st = CopsState()
+            self.bb.set(self._state_key, st)
+        return st
+
+    @property
+    def radio(self) -> Any:
+        return self.ctx.robot.radio if self.ctx.robot is not None else self.ctx.services["radio"]
+
+
+class InformationStorage(CopsSkill):
+    """Background task: listen, acknowledge, store.
+
+    Every tick it receives all ``cops`` messages: it acknowledges each info message
+    (duplicates too), merges its payload into the agent's knowledge and, for a newer
+    plan m, keeps it for ``WaitToReceivePlan``; it records acknowledgements and when
+    each sender was last heard. When the robot reaches a new location it merges
+    what its own sensing revealed and marks its own information fresh.
+
+    Reads/writes: ``cops`` (knowledge). Returns RUNNING.
+    """
+
+    PARAMS = dict(CopsSkill.PARAMS)
+
+    def __init__(self, name: str, ctx: AgentContext, remap: dict[str, str] | None = None, **params: Any):
+        super().__init__(name, ctx, remap, **params)
+        self._at: Any = ()
+
+    def initialise(self) -> None:
+        initial = self.ctx.services.get("initial_topology")
+        if initial is not None:
+            self.state.knowledge.topology.merge(Topology.from_dict(initial))
+
+    def update(self) -> Status:
+        st, now = self.state, self.ctx.clock.now_s
+        kn = st.knowledge
+        kn.heard[self.ctx.name] = now
+        for msg in self.radio.receive():
+            if msg.kind != KIND:
+                continue
+            d = msg.data
+            kn.heard[msg.sender] = now
+            if d["type"] == "ack":
+                kn.acked.add(d["id"])
+            elif d["type"] == "info":
+                self.radio.send(msg.sender, KIND, {"type": "ack", "id": d["id"]})
+                if d["id"] in kn.received:
+                    continue
+                kn.received.add(d["id"])
+                kn.absorb(d["payload"])
+                if d["info"] == MASTER and d["cycle"] > st.cycle and (
+                        kn.pending_plan is None or d["cycle"] > kn.pending_plan["cycle"]):
+                    kn.pending_plan = d
+        self._sense(st)
+        return Status.RUNNING
+
+    def _sense(self, st: CopsState) -> None:
+        view = network_view(self.ctx)
+        if view is None:
+            return
+        at = view.location()
+        if at == self._at:
+            return
+        self._at = at
+        if st.knowledge.topology.merge(Topology.from_dict(view.topology())):
+            st.knowledge.freshness[self.ctx.name] = max(st.cycle, 0)
+
+
+class IsLeader(Skill):
+    """Leader?: SUCCESS when this agent plans for the team (``leader``), else FAILURE."""
+
+    TYPE_NAME = "Leader?"
+    PARAMS = {"leader": Param(str, "base", "name of the agent responsible for planning")}
+
+    def update(self) -> Status:
+        return Status.SUCCESS if self.ctx.name == self.p["leader"] else Status.FAILURE
+
+
+class SolveCOPS(CopsSkill):
+    """COPS: plan the next cycle at the leader (the base station).
+
+    From everything the leader knows it builds the network N (explored locations),
+    places the team (robots not declared lost, where the last plan left them) and
+    plans pre-exploration, exploration and post-exploration (``plan_cycle``). Robots
+    whose earlier information never reached the base are added to the
+    post-exploration sources. With no frontier left, the plan is the recall: m
+    reaches every robot and brings it to the base. Every plan is checked with the
+    plan validator before it is used.
+
+    Reads services ``team`` (robot -> start location) and ``base_location``.
+    Writes ``cops`` (plan, cycle, part = pre, step = 0). Logs ``cops_plan``.
+    Returns SUCCESS with a plan, FAILURE when no plan exists (logged with the reason).
+    """
+
+    TYPE_NAME = "COPS"
+    PARAMS = {
+        **CopsSkill.PARAMS,
+        "delta_t_s": Param(float, 60.0, "ΔT: duration of one plan step (one transition)", exclusive_minimum=0),
+        "min_exploration_steps": Param(int, 4, "exploration time of a cycle, in steps of ΔT", minimum=1),
+        "lost_timeout_s": Param(float, 1200.0, "silence after which a partner is declared lost",
+                                exclusive_minimum=0),
+        "time_limit_s": Param(float, 10.0, "time limit of each integer program (wall clock)",
+                              exclusive_minimum=0),
+        "spacing_m": Param(float, 50.0, "location spacing: a move's cost is its length over this",
+                           exclusive_minimum=0),
+        "recall_after_s": Param(float, 1800.0, "standing order of m: a robot that receives no new plan "
+                                "this long after its part goes back to the base", exclusive_minimum=0),
+    }
+
+    def update(self) -> Status:
+        st = self.state
+        base_loc = st.base_location = self.ctx.services["base_location"]
+        team = self.ctx.services["team"]
+        kn = st.knowledge
+        positions = self._positions(st, team)
+        try:
+            net = team_network(kn.topology, base_loc, self.ctx.name, positions, spacing_m=self.p["spacing_m"])
+            positions = net.positions()
+            opts = SolverOptions(time_limit_s=self.p["time_limit_s"])
+            frontiers = net.frontiers
+            owed = {r for r in positions if st.explored_in.get(r, -1) > kn.freshness.get(r, -1)}
+            if frontiers:
+                cyc = self._cycle(net, positions, owed, opts)
+            elif owed:
+                cyc = self._collect(net, positions, owed, opts)
+            else:
+                cyc = self._recall(net, positions, opts)
+            if frontiers and not cyc.exploration and not owed:
+                raise PlanningError(f"{len(frontiers)} frontiers left but no robot that m can reach is "
+                                    f"sent to one (robots out of radio reach of the base and of each other)")
+            cyc.meta["explored"] = sorted(kn.topology.explored)
+            cyc.meta["returning"] = self._returning
+        except (PlanningError, ValueError) as err:
+            self.event("cops_no_plan", cycle=st.cycle + 1, reason=str(err))
+            self.feedback_message = str(err)
+            return Status.FAILURE
+        problems = validate_plan(net, cyc.pre) + validate_plan(net.with_positions(cyc.pre.final_positions()), cyc.post)
+        if problems:
+            self.event("cops_invalid_plan", cycle=st.cycle + 1, reason=str(problems[0]))
+            return Status.FAILURE
+        final = not frontiers and not owed and not cyc.meta.get("stranded")
+        st.cycle += 1
+        for r in cyc.exploration:
+            st.explored_in[r] = st.cycle
+        m = {"cycle": cyc.to_dict(), "final": final, "delta_t_s": self.p["delta_t_s"],
+             "lost_timeout_s": self.p["lost_timeout_s"], "recall_after_s": self.p["recall_after_s"],
+             "base_location": base_loc}
+        st.adopt({"plan": m, "cycle": st.cycle, "part": "pre", "t": 0})
+        st.knowledge.freshness[MASTER] = st.cycle
+        self.event("cops_plan", cycle=st.cycle, final=final, robots=len(positions) - 1,
+                   team=sorted(r for r in positions if r != self.ctx.name), locations=len(net),
+                   frontiers=len(frontiers), explorers=sorted(cyc.exploration), T_pre=cyc.pre.horizon,
+                   T_post=cyc.post.horizon, ext_com=_count(cyc, external=True), int_com=_count(cyc, external=False),
+                   transitions=sum(p.moves(r) for p in (cyc.pre, cyc.post) for r in p.robots),
+                   relayed=sum(1 for p in (cyc.pre, cyc.post) for c in p.communications
+                               if c.info not in (c.sender, MASTER)),
+                   solve_time_s=cyc.meta.get("solve_time_s"), gap=cyc.meta.get("gap"),
+                   clustered=bool(cyc.meta.get("clustered")), valid=True)
+        return Status.SUCCESS
+
+    _returning: list[str] = []
+
+    def _positions(self, st: CopsState, team: dict[str, str]) -> dict[str, str]:
+        """Where the last plan left each robot not declared lost; a robot the last
+        plan did not reach goes back to the base by the standing order of m."""
+        alive = {r: s for r, s in team.items() if r not in st.knowledge.lost}
+        if st.plan is None:
+            return alive
+        last = st.plan.post.final_positions()
+        reached = st.plan.pre.master_receivers() | st.plan.post.master_receivers()
+        pos = {r: last.get(r, s) if r in reached else st.base_location for r, s in alive.items()}
+        unreachable = _unreachable(st.knowledge.topology, st.base_location, pos)
+        self._returning = sorted(unreachable)
+        return {r: st.base_location if r in unreachable else s for r, s in pos.items()}
+
+    def _cycle(self, net, positions: dict[str, str], owed: set[str], opts: SolverOptions) -> CyclePlan:
+        """Pre-exploration, exploration and post-exploration; robots whose earlier
+        information the base lacks (``owed``) are post-exploration sources too."""
+        me = self.ctx.name
+        kw = dict(masters={me}, explorers=set(positions) - {me}, static={me},
+                  min_exploration_steps=self.p["min_exploration_steps"], options=opts)
+        try:
+            cyc = plan_cycle(net, **kw)
+        except PlanningError as err:  # too hard within the time limit: the nearest frontier only
+            hops = net.hop_distances(net.base)
+            nearest = min(net.frontiers, key=lambda s: (hops.get(s, math.inf), s))
+            self.event("cops_fallback", reason=str(err), frontier=nearest)
+            cyc = plan_cycle(net, frontiers={nearest}, **kw)
+        if owed - set(cyc.pre.explore):
+            post = solve_post_exploration(net, sources=sorted(set(cyc.pre.explore) | owed),
+                                          positions=cyc.pre.final_positions(),
+                                          masters=sorted(cyc.pre.master_receivers()), static={me}, options=opts)
+            cyc = CyclePlan(cyc.pre, post, cyc.exploration, {**cyc.meta, "owed": sorted(owed)})
+        return cyc
+
+    def _collect(self, net, positions: dict[str, str], owed: set[str], opts: SolverOptions) -> CyclePlan:
+        """No frontier left but information owed: a cycle of post-exploration only."""
+        me = self.ctx.name
+        pre = idle_plan(positions, {me}, "pre")
+        post = solve_post_exploration(net, sources=sorted(owed), positions=positions, masters=[me], static={me},
+                                      options=opts)
+        return CyclePlan(pre, post, {}, {"solve_time_s": post.meta.get("solve_time_s"), "owed": sorted(owed)})
+
+    def _recall(self, net, positions: dict[str, str], opts: SolverOptions) -> CyclePlan:
+        pre = solve_recall(net, positions=positions, masters={self.ctx.name}, static={self.ctx.name}, options=opts)
+        post = idle_plan(pre.final_positions(), pre.master_receivers(), "post")
+        return CyclePlan(pre, post, {}, {"solve_time_s": pre.meta.get("solve_time_s"), "recall": True,
+                                         "stranded": pre.meta["stranded"]})
+
+
+def _unreachable(topology: Topology, base: str, positions: dict[str, str]) -> set[str]:
+    """Robots a new plan m cannot reach: m spreads over communication edges between
+    occupied locations from the base; once one robot holds it, robots carry it to
+    every other. With nobody in the base's reach, everyone away is unreachable."""
+    occupied = set(positions.values()) | {base}
+    reach, todo = {base}, [base]
+    while todo:
+        s = todo.pop()
+        for u, v in topology.communication:
+            other = v if u == s else u if v == s else None
+            if other in occupied and other not in reach:
+                reach.add(other)
+                todo.append(other)
+    if any(s in reach for s in positions.values()):
+        return set()
+    return {r for r, s in positions.items() if s != base}
+
+
+def _count(cyc: CyclePlan, external: bool) -> int:
+    n = 0
+    for p in (cyc.pre, cyc.post):
+        for c in p.communications:
+            ext = p.location(c.sender, c.t) != p.location(c.receiver, c.t)
+            n += ext == external
+    return n
+
+
+class WaitToReceivePlan(CopsSkill):
+    """Wait to receive plan: RUNNING until a plan m newer than the last one has
+    arrived, then adopt it (continue from the step at which it arrived): SUCCESS.
+
+    Reads/writes ``cops``."""
+
+    def update(self) -> Status:
+        st = self.state
+        pending = st.knowledge.pending_plan
+        if pending is None or pending["cycle"] <= st.cycle:
+            return Status.RUNNING
+        st.adopt({"plan": pending["payload"]["plan"], "cycle": pending["cycle"], "part": pending["part"],
+                  "t": pending["t"]})
+        st.knowledge.pending_plan = None
+        self.event("cops_plan_received", cycle=st.cycle, part=st.part, step=st.step)
+        return Status.SUCCESS
+
+
+class ReturnWithoutPlan(CopsSkill):
+    """The standing order of m: a robot that has received no new plan
+    ``recall_after_s`` (from its last plan) after it started waiting goes back to the
+    base location, where the next plan reaches it (the base station plans it there).
+    Back at the base it greets the base station every ``greet_period_s``, so that a
+    robot wrongly declared lost is counted again.
+
+    Reads ``cops``; drives the robot. Returns RUNNING (a background task of the wait).
+    """
+
+    PARAMS = {**CopsSkill.PARAMS,
+              "greet_period_s": Param(float, 5.0, "greeting period once back at the base", exclusive_minimum=0),
+              "leader": Param(str, "base", "the agent to greet (the planner at the base)")}
+
+    def initialise(self) -> None:
+        self._since = self.ctx.clock.now_s
+        self._sent = False
+        self._greeted = -math.inf
+
+    def update(self) -> Status:
+        st, now = self.state, self.ctx.clock.now_s
+        if self.ctx.robot is None or st.plan is None:
+            return Status.RUNNING
+        if self._sent:
+            if network_view(self.ctx).location() == st.base_location and now - self._greeted >= \
+                    self.p["greet_period_s"]:
+                self._greeted = now
+                self.radio.send(self.p["leader"], KIND, {"type": "hello"})
+            return Status.RUNNING
+        if now - self._since >= st.recall_after_s:
+            view = network_view(self.ctx)
+            route = view.route(st.base_location) if view.location() != st.base_location else None
+            if route is not None:
+                self.follow(route)
+                self.event("return_without_plan", cycle=st.cycle)
+            self._sent = True
+        return Status.RUNNING
+
+    def terminate(self, new_status: Status) -> None:
+        self.stop_own_motion()
+
+
+class _PartCheck(CopsSkill):
+    ABSTRACT = True
+    PART = ""
+
+    def update(self) -> Status:
+        return Status.SUCCESS if self.state.part == self.PART else Status.FAILURE
+
+
+class IsExploring(_PartCheck):
+    """Explore?: SUCCESS when the agent is in the exploration phase, else FAILURE."""
+
+    TYPE_NAME = "Explore?"
+    PART = "explore"
+
+
+class FinishedPlan(_PartCheck):
+    """Finished plan?: SUCCESS when the agent has done its part of the cycle plan."""
+
+    TYPE_NAME = "FinishedPlan?"
+    PART = "done"
+
+
+class MissionComplete(CopsSkill):
+    """SUCCESS when the agent has executed the final plan (the recall), else FAILURE."""
+
+    TYPE_NAME = "MissionComplete?"
+
+    def update(self) -> Status:
+        st = self.state
+        return Status.SUCCESS if st.final and st.part == "done" else Status.FAILURE
+
+
+class CommunicationAction(CopsSkill):
+    """Communication Action of step t: PreIntCom, then ExtCom, then PostIntCom.
+
+    In each phase the agent re-sends its outgoing messages every ``resend_period_s``
+    until each is acknowledged, and waits until every incoming one has arrived
+    (``InformationStorage`` listens and acknowledges throughout). While it waits it
+    greets every partner of the step so that they know it is alive. A partner not
+    heard for ``lost_timeout_s`` (from the plan) is declared lost: its messages are
+    dropped from the plan and the agent goes on.
+
+    Reads/writes ``cops``. Logs ``cops_phase`` per completed phase and
+    ``robot_declared_lost``. Returns RUNNING until all communication of step t is
+    done, then SUCCESS.
+    """
+
+    PARAMS = {**CopsSkill.PARAMS,
+              "resend_period_s": Param(float, 5.0, "re-send an unacknowledged message this often",
+                                       exclusive_minimum=0)}
+
+    def initialise(self) -> None:
+        st = self.state
+        plan = st.part_plan()
+        self._phases = list(plan.communication_phases(st.step, self.ctx.name).items()) if plan else []
+        self._i = 0
+        self._sent: dict[str, float] = {}
+        self._since = self.ctx.clock.now_s
+        self._partners = sorted(set(plan.robots) - {self.ctx.name}) if plan else []
+        self._greeted = -math.inf
+
+    def update(self) -> Status:
+        st, now = self.state, self.ctx.clock.now_s
+        kn = st.knowledge
+        self._greet(now, kn)
+        while self._i < len(self._phases):
+            name, comms = self._phases[self._i]
+            waiting = [c for c in comms if not self._done(c, st)]
+            if waiting:
+                for c in waiting:
+                    other = c.receiver if c.sender == self.ctx.name else c.sender
+                    if other in kn.lost:
+                        continue
+                    silent_s = now - max(self._since, kn.heard.get(other, -math.inf))
+                    if silent_s > st.lost_timeout_s + self._allow(other):
+                        kn.declared[other] = now
+                        self.event("robot_declared_lost", robot=other, cycle=st.cycle, part=st.part, step=st.step)
+                    elif c.sender == self.ctx.name:
+                        self._send(c, st, now)
+                self.feedback_message = f"t={st.step} {name}: {len(waiting)} to go"
+                if any(not self._done(c, st) for c in waiting):
+                    return Status.RUNNING
+            self.event("cops_phase", cycle=st.cycle, part=st.part, step=st.step, phase=name, messages=len(comms))
+            self._i += 1
+            self._since = now
+        return Status.SUCCESS
+
+    def _allow(self, other: str) -> float:
+        """Extra silence allowed for a partner that explores out of radio reach (its
+        exploration time and the way back) or comes back by the standing order."""
+        st = self.state
+        if other in st.plan.meta.get("returning", ()):
+            return st.recall_after_s + st.lost_timeout_s
+        task = st.plan.exploration.get(other) if st.part == "post" else None
+        return 2.0 * task.steps * st.delta_t_s if task else 0.0
+
+    def _done(self, c: Communication, st: CopsState) -> bool:
+        kn = st.knowledge
+        mid = message_id(st.cycle, st.part, c)
+        other = c.receiver if c.sender == self.ctx.name else c.sender
+        return other in kn.lost or (mid in kn.acked if c.sender == self.ctx.name else mid in kn.received)
+
+    def _send(self, c: Communication, st: CopsState, now: float) -> None:
+        mid = message_id(st.cycle, st.part, c)
+        if now - self._sent.get(mid, -math.inf) < self.p["resend_period_s"]:
+            return
+        self._sent[mid] = now
+        payload = st.knowledge.payload()
+        if c.info == MASTER:
+            payload["plan"] = {"cycle": st.plan.to_dict(), "final": st.final, "delta_t_s": st.delta_t_s,
+                               "lost_timeout_s": st.lost_timeout_s, "recall_after_s": st.recall_after_s,
+                               "base_location": st.base_location}
+        self.radio.send(c.receiver, KIND, {"type": "info", "id": mid, "cycle": st.cycle, "part": st.part,
+                                           "t": c.t, "info": c.info, "payload": payload})
+
+    def _greet(self, now: float, kn: Knowledge) -> None:
+        if now - self._greeted < self.p["resend_period_s"]:
+            return
+        self._greeted = now
+        for other in self._partners:
+            self.radio.send(other, KIND, {"type": "hello"})
+
+
+class TransitionAction(CopsSkill):
+    """Transition Action: move to the plan's next location s_{t+1} and set t = t + 1.
+
+    At the last step of a part it moves on: pre-exploration to exploration (a robot
+    the plan sends exploring) or to post-exploration, post-exploration to done.
+
+    Reads/writes ``cops``; drives the robot through its NetworkView's routes.
+    Returns RUNNING while moving, SUCCESS on arrival (at once for a stay), FAILURE
+    when the location cannot be reached.
+    """
+
+    def initialise(self) -> None:
+        self._target: str | None = None
+
+    def update(self) -> Status:
+        st = self.state
+        plan = st.part_plan()
+        if plan is None:
+            return Status.FAILURE
+        if st.step >= plan.horizon:
+            self._next_part(st)
+            return Status.SUCCESS
+        here, there = plan.location(self.ctx.name, st.step), plan.location(self.ctx.name, st.step + 1)
+        if here != there and self.ctx.robot is not None:
+            view = network_view(self.ctx)
+            if view.location() != there:
+                if self._target != there:
+                    route = view.route(there)
+                    if route is None:
+                        self.feedback_message = f"no route to {there}"
+                        return Status.FAILURE
+                    self.follow(route)
+                    self._target = there
+                if self.robot.path_status == "blocked":
+                    self.feedback_message = f"blocked on the way to {there}"
+                    return Status.FAILURE
+                return Status.RUNNING
+        st.step += 1
+        return Status.SUCCESS
+
+    def _next_part(self, st: CopsState) -> None:
+        if st.part == "pre":
+            st.part = "explore" if self.ctx.name in st.plan.exploration else "post"
+        else:
+            st.part = "done"
+        st.step = 0
+
+    def terminate(self, new_status: Status) -> None:
+        if new_status == Status.INVALID:
+            self.stop_own_motion()
+
+
+class ActionTimer(CopsSkill):
+    """Action Timer: RUNNING for ΔT (from the plan) when the step has a transition
+    to make, so that robots stay in step; SUCCESS at once at the last step of a part.
+    Reads ``cops``."""
+
+    def initialise(self) -> None:
+        st = self.state
+        plan = st.part_plan()
+        last = plan is None or st.step >= plan.horizon
+        self._until = self.ctx.clock.now_s + (0.0 if last else st.delta_t_s)
+
+    def update(self) -> Status:
+        return Status.SUCCESS if self.ctx.clock.now_s >= self._until - 1e-9 else Status.RUNNING
+
+
+class ExplorationTimer(CopsSkill):
+    """Exploration Timer: RUNNING for the robot's exploration time (its task's steps
+    times ΔT), then SUCCESS. Reads ``cops``."""
+
+    def initialise(self) -> None:
+        st = self.state
+        task = st.plan.exploration.get(self.ctx.name) if st.plan else None
+        self._until = self.ctx.clock.now_s + (task.steps * st.delta_t_s if task else 0.0)
+
+    def update(self) -> Status:
+        return Status.SUCCESS if self.ctx.clock.now_s >= self._until - 1e-9 else Status.RUNNING
+
+
+def _bearing(a: Any, b: Any) -> float:
+    return math.atan2(b[1] - a[1], b[0] - a[0])
+
+
+def ordered_choices(topology: Topology, at: str, came_from: str | None, candidates: list[str]) -> list[str]:
+    """Algorithm 1's choices in an order every robot agrees on without talking:
+    clockwise from the direction the robot came from (from +x at a frontier)."""
+    p = topology.locations[at]
+    ref = _bearing(p, topology.locations[came_from]) if came_from else math.pi
+
+    def turn(s: str) -> float:
+        return (ref - _bearing(p, topology.locations[s])) % (2 * math.pi)
+    return sorted(candidates, key=lambda s: (round(turn(s), 6), s))
+
+
+class ExplorationAction(CopsSkill):
+    """Exploration Action (Algorithm 1): communication-free split at forks.
+
+    Starting at its frontier with frontier index i, the robot repeats: c = number of
+    choices (at the frontier: its unexplored exits; further on: the tunnels other than
+    the one it came by), choice = i mod c, i = i div c, move one location towards the
+    choice. Robots sent to one frontier thus spread over its branches (Figure 5). At a
+    dead end it waits. Runs until the Exploration Timer stops it.
+
+    Reads ``cops`` (the plan's exploration task and network); drives the robot.
+    Logs ``exploration_choice``. Returns RUNNING (FAILURE if a move is impossible).
+    """
+
+    def initialise(self) -> None:
+        st = self.state
+        task = st.plan.exploration[self.ctx.name]
+        self._i, self._at, self._prev = task.index, task.frontier, None
+        self._moving: str | None = None
+        self._visited = {task.frontier}
+        st.knowledge.freshness[self.ctx.name] = st.cycle
+
+    def update(self) -> Status:
+        st = self.state
+        view = network_view(self.ctx)
+        topo = st.knowledge.topology
+        if self._moving is not None:
+            if view.location() != self._moving:
+                return Status.FAILURE if self.robot.path_status == "blocked" else Status.RUNNING
+            self._prev, self._at, self._moving = self._at, self._moving, None
+            self._visited.add(self._at)
+        if self._prev is None:
+            explored = set(st.plan.meta.get("explored", ()))
+            cands = [s for s in topo.neighbours(self._at) if s not in explored]
+        else:
+            cands = [s for s in topo.neighbours(self._at) if s != self._prev and s not in self._visited]
+        choices = ordered_choices(topo, self._at, self._prev, cands)
+        if not choices:
+            self.feedback_message = f"dead end at {self._at}"
+            return Status.RUNNING
+        c = len(choices)
+        choice, i = choices[self._i % c], self._i // c
+        self.event("exploration_choice", at=self._at, choices=choices, index=self._i, choice=choice)
+        self._i = i
+        route = view.route(choice)
+        if route is None:
+            return Status.FAILURE
+        self.follow(route)
+        self._moving = choice
+        self.feedback_message = f"to {choice} (i={self._i})"
+        return Status.RUNNING
+
+    def terminate(self, new_status: Status) -> None:
+        self.stop_own_motion()
+
+
+class TransitToReturnNode(CopsSkill):
+    """Transit to return node: go back to the frontier the exploration started from,
+    then continue with post-exploration (step 0).
+
+    Reads/writes ``cops``; drives the robot. Returns RUNNING on the way, SUCCESS
+    there, FAILURE without a route.
+    """
+
+    def initialise(self) -> None:
+        self._sent = False
+
+    def update(self) -> Status:
+        st = self.state
+        frontier = st.plan.exploration[self.ctx.name].frontier
+        view = network_view(self.ctx)
+        if view.location() != frontier:
+            if not self._sent:
+                route = view.route(frontier)
+                if route is None:
+                    return Status.FAILURE
+                self.follow(route)
+                self._sent = True
+            return Status.FAILURE if self.robot.path_status == "blocked" else Status.RUNNING
+        st.part, st.step = "post", 0
+        return Status.SUCCESS
+
+    def terminate(self, new_status: Status) -> None:
+        if new_status == Status.INVALID:
+            self.stop_own_motion()
