@@ -55,14 +55,18 @@ def main(argv=None) -> int:
     ap.add_argument("--robots", type=int, nargs="+", default=[2, 5, 10, 20])
     ap.add_argument("--time-limit", type=float, default=4.0, help="seconds per integer program")
     ap.add_argument("--probe-limit", type=float, default=1.0, help="seconds per horizon probe")
+    ap.add_argument("--total-limit", type=float, default=10.0,
+                    help="seconds for the whole cycle (each program's limit is cut to its share)")
     ap.add_argument("--cell-limit", type=float, default=40.0,
                     help="skip larger teams on a size once a cycle took this long")
     ap.add_argument("--repeats", type=int, default=3, help="runs per cell when a run takes < 2 s")
     ap.add_argument("--seed", type=int, default=1)
     args = ap.parse_args(argv)
     print("command:", " ".join(shlex.quote(a) for a in [sys.executable] + sys.argv))
-    print(f"solver: {available_solver()}; per-solve limit {args.time_limit:g} s, probe limit {args.probe_limit:g} s")
-    opts = SolverOptions(time_limit_s=args.time_limit, probe_time_limit_s=args.probe_limit, mip_gap=0.01)
+    print(f"solver: {available_solver()}; per-solve limit {args.time_limit:g} s, probe limit {args.probe_limit:g} s, "
+          f"cycle limit {args.total_limit:g} s")
+    opts = SolverOptions(time_limit_s=args.time_limit, probe_time_limit_s=args.probe_limit, mip_gap=0.01,
+                         total_time_limit_s=args.total_limit)
     header = f"{'locations':>9} {'robots':>6} {'clustering':>10} {'cycle_s':>8} {'T_pre':>5} {'T_post':>6} " \
              f"{'clusters':>8} {'explorers':>9} {'gap':>8}  result"
     print(header)

@@ -26,24 +26,26 @@ from __future__ import annotations
 
 import math
 import time
+import threading
 from collections import defaultdict, deque
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
-from typing import Iterable, Mapping
+from typing import Callable, Iterable, Mapping
 
 import networkx as nx
 
 from .ilp import InfeasibleProblem, PlanningError, SolverOptions
 from .network import MCNetwork
 from .plan import Communication, CyclePlan, ExplorationTask, Plan, Requirement
-from .problems import (DEFAULT_MIN_EXPLORATION_STEPS, FrontierReward, _masters, _robot_sets,
-                       solve_post_exploration, solve_pre_exploration)
+from .problems import (DEFAULT_MIN_EXPLORATION_STEPS, PRE_SHARE, FrontierReward, _Budget, _masters,
+                       _robot_sets, solve_post_exploration, solve_pre_exploration)
 
 #: Default largest number of locations in a cluster before it is cut.
 DEFAULT_MAX_CLUSTER_LOCATIONS = 24
 #: Reward per robot that an idle cluster's evacuation plan earns at the parent cluster.
 DEFAULT_EVACUATION_REWARD = 10.0
 #: Estimated problem size (robot classes x horizon x arcs) above which "auto" clusters.
-AUTO_CLUSTER_SIZE = 40000
+AUTO_CLUSTER_SIZE = 30000
 
 
 def _tree_distances(network: MCNetwork, base: str) -> dict[str, int]:
@@ -248,18 +250,19 @@ def plan_cycle_clustered(network: MCNetwork, *, positions: Mapping[str, str] | N
         if not any(nx.has_path(network.mobility, pos[r], s) for r in mobile_ex):
             raise InfeasibleProblem(f"frontier {s} cannot be reached by any capable robot")
     cs = build_clusters(network, pos, fr, pos[base_station], st, ex, max_cluster_locations)
-    opts = options or SolverOptions()
-    pre, pre_done = _clustered_pre(network, cs, pos, ms, st, ex, reward, evacuation_reward, max_horizon, opts)
+    budget = _Budget(options or SolverOptions())
+    pre, pre_done = _clustered_pre(network, cs, pos, ms, st, ex, reward, evacuation_reward, max_horizon,
+                                   budget.options(PRE_SHARE))
     post_pos = pre.final_positions()
     post_masters = pre.master_receivers()
     try:
         post, post_join = _clustered_post(network, cs, pre, post_pos, post_masters, st, base_station,
-                                          max_horizon, opts)
+                                          max_horizon, budget.options())
         post_clustered = True
     except PlanningError:
         post = solve_post_exploration(network, sources=sorted(pre.explore), positions=post_pos,
                                       masters=sorted(post_masters), static=st, max_horizon=max_horizon,
-                                      options=opts)
+                                      options=budget.options())
         post_join = {r: 0 for r in pos}
         post_clustered = False
     # exploration times (Figure 3): the tightest cluster gets the minimum exploration time
@@ -279,6 +282,29 @@ def plan_cycle_clustered(network: MCNetwork, *, positions: Mapping[str, str] | N
         "gap": _gap([pre, post])})
 
 
+def _solve_all(jobs: list[tuple[str, float, Callable[[SolverOptions], Plan]]], opts: SolverOptions) -> dict[str, Plan]:
+    """Run independent cluster problems, ``opts.workers`` at once (the solver releases
+    the interpreter while it works). A job (name, weight, solve) may use the share of
+    the time left that its weight has among the jobs not yet started (times the
+    number of workers); raises the first job's error, if any."""
+    budget = _Budget(opts)
+    workers = max(1, min(int(opts.workers or 1), len(jobs)))
+    lock = threading.Lock()
+    waiting = {name: w for name, w, _ in jobs}
+
+    def run(name: str, fn: Callable[[SolverOptions], Plan]) -> Plan:
+        with lock:
+            total = sum(waiting.values()) or 1.0
+            share = min(1.0, workers * waiting.pop(name) / total)
+        return fn(budget.options(share))
+
+    if workers == 1:
+        return {name: run(name, fn) for name, _w, fn in jobs}
+    with ThreadPoolExecutor(max_workers=workers) as pool:
+        futures = {name: pool.submit(run, name, fn) for name, _w, fn in jobs}
+        return {name: f.result() for name, f in futures.items()}
+
+
 def _clustered_pre(network, cs: ClusterStructure, pos, ms, st, ex, reward, evacuation_reward, max_horizon, opts):
     C = cs.clusters
     all_locs = set(network.locations)
@@ -288,9 +314,13 @@ def _clustered_pre(network, cs: ClusterStructure, pos, ms, st, ex, reward, evacu
         if c.parent is not None:
             mobile = [r for r in c.robots if r not in st]
             sub_pre[name] = _nearest(network, mobile or c.robots, pos, c.root, c.locations, ms)
-    plans: dict[str, Plan] = {}
-    start: dict[str, int] = {cs.master: 0}
+    # a cluster's problem does not depend on its parent's plan, only when it starts does:
+    # all are solved at once, then patched together
     cmasters: dict[str, set[str]] = {cs.master: ms & set(C[cs.master].robots)}
+    for name in cs.parent_first():
+        for k in C[name].children:
+            cmasters[k] = {sub_pre[k]} | (ms & set(C[k].robots))
+    jobs = []
     for name in cs.parent_first():
         c = C[name]
         locs = set(c.locations)
@@ -306,17 +336,24 @@ def _clustered_pre(network, cs: ClusterStructure, pos, ms, st, ex, reward, evacu
             locs.add(c.gateway)
             n_mobile = sum(1 for r in c.robots if r not in st)
             extra = {c.gateway: tuple([evacuation_reward] * max(n_mobile, 1))}
-        plan = solve_pre_exploration(
-            network.subnetwork(locs & all_locs), positions=sub_pos, frontiers=c.frontiers,
-            masters=cmasters[name], reward=reward, explorers=ex & set(c.robots),
-            static=(st & set(sub_pos)) | set(sinks), extra_rewards=extra, master_sinks=sinks,
-            strict_frontiers=False, max_horizon=max_horizon, options=opts, phase="pre")
-        plans[name] = plan
-        for k in c.children:
+        mobile = sum(1 for r in sub_pos if r not in st and r not in sinks)
+
+        def solve(o: SolverOptions, locs=locs, sub_pos=sub_pos, sinks=sinks, extra=extra, c=c) -> Plan:
+            return solve_pre_exploration(
+                network.subnetwork(locs & all_locs), positions=sub_pos, frontiers=c.frontiers,
+                masters=cmasters[c.name], reward=reward, explorers=ex & set(c.robots),
+                static=(st & set(sub_pos)) | set(sinks), extra_rewards=extra, master_sinks=sinks,
+                strict_frontiers=False, max_horizon=max_horizon, options=o, phase="pre")
+
+        jobs.append((name, float(max(mobile, 1) * len(locs)), solve))
+    plans = _solve_all(jobs, opts)
+    start: dict[str, int] = {cs.master: 0}
+    for name in cs.parent_first():
+        plan = plans[name]
+        for k in C[name].children:
             sm = sub_pre[k]
             involved = [x.t for x in plan.communications if sm in (x.sender, x.receiver)]
             start[k] = start[name] + (max(involved) if involved else plan.horizon)
-            cmasters[k] = {sm} | (ms & set(C[k].robots))
     end = {k: start[k] + plans[k].horizon for k in plans}
     H = max(end.values())
     traj: dict[str, list[str]] = {}
@@ -350,7 +387,9 @@ def _clustered_post(network, cs: ClusterStructure, pre: Plan, post_pos, post_mas
     carries: dict[str, set[str]] = {}
     sub_post: dict[str, str] = {}
     final_pos: dict[str, str] = {}
-    plans: dict[str, Plan] = {}
+    jobs = []
+    # every cluster's problem is known before any is solved: a child's sub-master ends
+    # at the child's root (or stays, when static) holding what its sources held
     for name in cs.children_first():
         c = C[name]
         child_subs = {k: sub_post[k] for k in c.children if k in sub_post}
@@ -374,19 +413,24 @@ def _clustered_post(network, cs: ClusterStructure, pre: Plan, post_pos, post_mas
         statics = (st & set(sub_positions)) | set(child_subs.values())
         if c.parent is None:
             statics.add(sink)
-        plan = solve_post_exploration(
-            network.subnetwork(locs), sources=sources, positions=sub_positions,
-            masters=(post_masters & set(sub_positions)) | set(child_subs.values()), base_station=sink,
-            static=statics, holdings=holdings, max_horizon=max_horizon, static_sink=c.parent is None,
-            sink_final_location=None if c.parent is None or sink in statics else c.root,
-            options=opts, phase="post")
-        plans[name] = plan
+        final = None if c.parent is None or sink in statics else c.root
         sub_post[name] = sink
-        final_pos[sink] = plan.trajectories[sink][-1]
+        final_pos[sink] = final or sub_positions[sink]
         labels = set(holdings.get(sink, {sink}))
         for r in sources:
             labels |= set(holdings.get(r, {r}))
         carries[name] = labels
+
+        def solve(o: SolverOptions, locs=locs, sources=sources, sub_positions=sub_positions, holdings=holdings,
+                  statics=statics, sink=sink, final=final, c=c) -> Plan:
+            return solve_post_exploration(
+                network.subnetwork(locs), sources=sources, positions=sub_positions,
+                masters=(post_masters & set(sub_positions)) | set(holdings), base_station=sink,
+                static=statics, holdings=holdings, max_horizon=max_horizon, static_sink=c.parent is None,
+                sink_final_location=final, options=o, phase="post")
+
+        jobs.append((name, float(len(sources) * len(locs)), solve))
+    plans = _solve_all(jobs, opts)
     # a child's plan ends before its parent first uses the child's sub-master
     start: dict[str, int] = {}
     for name in cs.parent_first():

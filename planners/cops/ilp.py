@@ -53,6 +53,8 @@ from .network import MCNetwork
 from .plan import MASTER, Communication, Plan, Requirement
 
 _EPS = 1e-6
+#: HiGHS presolve_rule_off bit that turns probing off.
+_PRESOLVE_NO_PROBING = 1 << 15
 
 
 class PlanningError(Exception):
@@ -75,6 +77,13 @@ class SolverOptions:
     ``time_limit_s`` bounds every solve (the best plan found so far is returned, with
     its optimality gap); ``mip_gap`` is the relative gap at which a solve stops;
     ``probe_time_limit_s`` bounds each feasibility probe of the horizon search.
+    ``total_time_limit_s`` bounds one call of ``plan_cycle`` (or of
+    ``solve_pre_exploration`` / ``solve_post_exploration``): every solve's limit is
+    cut to its share of the time left, so the call returns about then with the best
+    plans found (model building and a last short solve may overrun it a little);
+    None for no bound. ``workers``: independent problems (clusters) solved at once.
+    ``stall_time_s``: a solve that holds a plan stops when the plan has not improved
+    for this long (nor for half the time it took to find it); None to disable.
     """
 
     time_limit_s: float | None = 30.0
@@ -82,6 +91,9 @@ class SolverOptions:
     solver: str | None = None
     threads: int = 1
     probe_time_limit_s: float | None = 5.0
+    total_time_limit_s: float | None = 10.0
+    workers: int = 2
+    stall_time_s: float | None = 2.0
 
 
 def available_solver(name: str | None = None) -> str:
@@ -125,6 +137,13 @@ class ConnectivityProblem:
     R(s, 1) − R(s, 0), R(s, 2) − R(s, 1), ... for robots of ``reward_robots``
     (default: ``explorers``) holding m at s at T; robots so rewarded at a location of
     ``frontiers`` are sent exploring. ``master_sinks`` must hold m by T.
+
+    ``warm_start`` gives trajectories (robot -> locations from t = 0, the last one
+    held to T) of a plan believed feasible; the solver completes it and starts from
+    it, so a solve stopped by its time limit returns at least that plan.
+    ``time_weight`` is a tiny cost per action and step index: of equally good plans
+    the earliest wins, which lets a search solve once at a generous horizon and cut
+    the plan after its last action.
     """
 
     network: MCNetwork
@@ -145,6 +164,8 @@ class ConnectivityProblem:
     phase: str = "plan"
     options: SolverOptions = field(default_factory=SolverOptions)
     feasibility_only: bool = False
+    warm_start: Mapping[str, list[str]] | None = None
+    time_weight: float = 0.0
 
     def holding(self, r: str) -> set[str]:
         return set(self.holdings.get(r, {r}))
@@ -208,6 +229,7 @@ class _Commodity:
     single_sink: bool
     earliest: dict[str, int]
     latest_slack: dict[str, int] | None  # location -> min steps still needed to reach a sink
+    unit_labels: int = 1                # labels one unit of flow stands for (its message cost)
 
 
 class _Model:
@@ -219,25 +241,37 @@ class _Model:
         self.T = p.horizon
         self.lp = pulp.LpProblem("cops", pulp.LpMaximize)
         self.nvar = 0
+        self.vars: list[pulp.LpVariable] = []
+        self.rows: list = []
         self.infeasible_reason: str | None = None
-        self.objective: list = []
+        self.objective = pulp.LpAffineExpression()
         self.cost_terms: list = []
         self.reward_terms: list = []
+        self.time_terms: list = []
 
     def var(self, lo: float = 0, hi: float | None = None, cat: str = pulp.LpContinuous) -> pulp.LpVariable:
         self.nvar += 1
         if cat == pulp.LpInteger and lo == 0 and hi == 1:
             cat = pulp.LpBinary
         if hasattr(self.lp, "add_variable"):
-            return self.lp.add_variable(f"v{self.nvar}", lo, hi, cat=cat)
-        return pulp.LpVariable(f"v{self.nvar}", lo, hi, cat)  # pragma: no cover - older pulp
+            v = self.lp.add_variable(f"v{self.nvar}", lo, hi, cat=cat)
+        else:  # pragma: no cover - older pulp
+            v = pulp.LpVariable(f"v{self.nvar}", lo, hi, cat)
+        self.vars.append(v)
+        return v
+
+    def timed(self, t: int, var) -> None:
+        """A tiny cost on an action at step t (``time_weight``): of equally good plans,
+        the one that acts earliest wins, so the plan can be cut short after its last action."""
+        if self.p.time_weight:
+            self.time_terms.append((self.p.time_weight * (t + 1)) * var)
 
     def add(self, constraint) -> None:
         if isinstance(constraint, bool):
             if not constraint:
                 self.infeasible_reason = self.infeasible_reason or "constant constraint violated"
             return
-        self.lp += constraint
+        self.rows.append(constraint)
 
     def le(self, terms: list, rhs) -> None:
         """Σ terms <= rhs with rhs a constant or an expression."""
@@ -276,6 +310,11 @@ class _Model:
         master_sinks = (set(p.master_sinks) | sinks) - masters
         self.master_sinks = master_sinks
 
+        # canonical orders (by name): the model, and so the solver's path, do not depend
+        # on the order in which the network's graphs were built
+        succ = {u: sorted(net.mobility.successors(u)) for u in net.mobility}
+        comm_edges = sorted(net.communication.edges)
+        self.succ = succ
         # ---- classes ---------------------------------------------------------------
         groups: dict[tuple, list[str]] = defaultdict(list)
         for r in robots:
@@ -297,6 +336,7 @@ class _Model:
                         hop_cache[start] = net.hop_distances(start)
                     earliest = {v: h + int(delay) for v, h in hop_cache[start].items() if h + delay <= T}
                     earliest[start] = 0
+                    earliest = dict(sorted(earliest.items()))
             classes.append(_Class(len(classes), start, static, expl, rew, col, sorted(groups[key]), earliest))
         self.classes = classes
         self.class_of = {r: c for c in classes for r in c.robots}
@@ -314,7 +354,7 @@ class _Model:
                 for u, e in c.earliest.items():
                     if e > t:
                         continue
-                    outs = [u] + [v for v in net.mobility.successors(u) if c.earliest.get(v, math.inf) <= t + 1]
+                    outs = [u] + [v for v in succ[u] if c.earliest.get(v, math.inf) <= t + 1]
                     for v in outs:
                         var = self.var(0, c.n, pulp.LpInteger)
                         x[c.idx, t, u, v] = var
@@ -324,6 +364,7 @@ class _Model:
                             cost = net.mobility_cost(u, v)
                             if cost:
                                 self.cost_terms.append(cost * var)
+                            self.timed(t, var)
                     out_terms = [x[c.idx, t, u, v] for v in outs]
                     if t == 0:
                         self.eq(out_terms, c.n if u == c.start else 0)
@@ -416,7 +457,7 @@ class _Model:
                 outflow[u, t].append(f)
                 inflow[v, t + 1].append(f)
             for t in range(T + 1):
-                for u, v in net.communication.edges:
+                for u, v in comm_edges:
                     if not (m_possible(u, t) and v in occupiable[t] and m_useful(v, t)):
                         continue
                     f = self.var(0, U)
@@ -427,10 +468,11 @@ class _Model:
                     cost = net.communication_cost(u, v)
                     if cost:
                         self.cost_terms.append(cost * e)
+                    self.timed(t, e)
                     outflow[u, t].append(f)
                     inflow[v, t].append(f)
                     self.m_arcs[t, u, v] = (f, e)
-            for key in set(inflow) | set(outflow):
+            for key in sorted(set(inflow) | set(outflow), key=lambda k: (k[1], k[0])):
                 v, t = key
                 supply = U if (t == 0 and v in master_locs) else 0
                 # in + supply >= out + absorbed (m may be dropped, never created)
@@ -440,7 +482,7 @@ class _Model:
                 if c.static or c.start not in gated_set:
                     continue
                 for t in range(T):
-                    leave = [x[c.idx, t, c.start, v] for v in net.mobility.successors(c.start)
+                    leave = [x[c.idx, t, c.start, v] for v in succ[c.start]
                              if (c.idx, t, c.start, v) in x]
                     if leave:
                         self.le(leave, c.n * g_at(c.start, t))
@@ -458,6 +500,21 @@ class _Model:
             for b in q.sources:
                 if p.holding(b):
                     by_loc[pos[b]].append(b)
+            if len(qsinks) == 1:
+                # one sink: a single commodity, one unit per label; every unit leaves its
+                # source and ends at the sink, so the flow's path decomposition gives each
+                # source a route to the sink (and the model is |sources| times smaller)
+                snk = qsinks[0]
+                supply = {}
+                for u in sorted(by_loc):
+                    labels_u = set().union(*(p.holding(b) for b in by_loc[u] if b != snk)) - {MASTER}
+                    if any(b != snk for b in by_loc[u]):
+                        supply[u] = max(1, len(labels_u))
+                if supply:
+                    labels = frozenset().union(*(p.holding(b) for u in supply for b in by_loc[u] if b != snk))
+                    commodities.append(self._commodity(labels, supply, {snk: sum(supply.values())}, True,
+                                                       master_locs, unit_labels=1))
+                continue
             for u in sorted(by_loc):
                 need = [s for s in qsinks if any(b != s for b in by_loc[u])]
                 if not need:
@@ -487,21 +544,23 @@ class _Model:
                 inflow[v, t + 1].append(f)
             arcs = {}
             for t in range(T + 1):
-                for u, v in net.communication.edges:
+                for u, v in comm_edges:
                     if not (possible(u, t) and possible(v, t)):
                         continue
                     f = self.var(0, U)
                     self.le([f], U * total_occ(t, v))
                     self.le([f], U * mholder(t, u))
-                    cost = net.communication_cost(u, v) * len(k.labels - {MASTER})
+                    cost = net.communication_cost(u, v) * k.unit_labels
                     if k.single_sink:
                         if cost:
                             self.cost_terms.append(cost * f)
+                        self.timed(t, f)
                     else:
                         e = self.var(0, 1, pulp.LpBinary)
                         self.le([f], U * e)
                         if cost:
                             self.cost_terms.append(cost * e)
+                        self.timed(t, e)
                     outflow[u, t].append(f)
                     inflow[v, t].append(f)
                     arcs[t, u, v] = f
@@ -514,7 +573,7 @@ class _Model:
                     if e <= T:
                         demand_terms[v, T].append(amount * occ(c, T, v))
                         nodes.add((v, T))
-            for key in nodes:
+            for key in sorted(nodes, key=lambda k: (k[1], k[0])):
                 v, t = key
                 supply = k.supply.get(v, 0) if t == 0 else 0
                 self.eq(inflow.get(key, []) + [supply],
@@ -565,14 +624,14 @@ class _Model:
                     if not terms:
                         continue
                     if n0 >= 2:  # robots that start together may stay; nobody else may come
-                        arrivals = [x[c.idx, t - 1, u, v] for c in col for u in net.mobility.predecessors(v)
+                        arrivals = [x[c.idx, t - 1, u, v] for c in col for u in sorted(net.mobility.predecessors(v))
                                     if (c.idx, t - 1, u, v) in x]
                         if arrivals:
                             self.le(arrivals, 0)
                     else:
                         self.le(terms, 1)
             done = set()
-            for u, v in net.mobility.edges:
+            for u, v in sorted(net.mobility.edges):
                 if (v, u) in done or not (u in p.collision_locations or v in p.collision_locations):
                     continue
                 done.add((u, v))
@@ -581,12 +640,12 @@ class _Model:
                     if len(terms) > 1:
                         self.le(terms, 1)
 
-        if p.feasibility_only:
-            self.lp += pulp.LpAffineExpression()
-        else:
-            self.lp += pulp.lpSum(self.reward_terms) - pulp.lpSum(self.cost_terms)
+        if not p.feasibility_only:
+            self.objective = (pulp.lpSum(self.reward_terms) - pulp.lpSum(self.cost_terms)
+                              - pulp.lpSum(self.time_terms))
 
-    def _commodity(self, labels, supply, demand, single_sink, master_locs) -> _Commodity:
+    def _commodity(self, labels, supply, demand, single_sink, master_locs,
+                   unit_labels: int | None = None) -> _Commodity:
         start = {u: (0 if u in master_locs else int(min(self.m_dist.get(u, math.inf), self.T + 1)))
                  for u in supply}
         earliest = information_distance(self.net, list(supply), start=start)
@@ -598,11 +657,14 @@ class _Model:
             c = self.class_of[s]
             if c.static:
                 sink_locs.append(c.start)
+            elif s in self.p.final_positions:  # the sink ends there, so must its information
+                sink_locs.append(self.p.final_positions[s])
             else:
                 all_static = False
         slack = information_distance(self.net, sink_locs, reverse=True) if all_static else None
-        bound = max(1, len(demand))
-        return _Commodity(labels, supply, demand, bound, single_sink, earliest, slack)
+        bound = max(1, sum(demand.values()))
+        per_unit = len(labels - {MASTER}) if unit_labels is None else unit_labels
+        return _Commodity(labels, supply, demand, bound, single_sink, earliest, slack, per_unit)
 
 
 # ---------------------------------------------------------------------------------------
@@ -614,10 +676,195 @@ def _val(v) -> float:
     return 0.0 if x is None else float(x)
 
 
-def solve_connectivity(p: ConnectivityProblem) -> Plan | None:
+@dataclass
+class _Outcome:
+    """What one solve of a built model gave: ``status`` is "optimal", "feasible" (an
+    incumbent when the time limit passed), "infeasible" or "unknown" (no plan and no
+    proof either way, usually the time limit)."""
+
+    status: str
+    gap: float | None = None
+    timed_out: bool = False
+
+
+def _warm_values(model: _Model) -> dict[int, float] | None:
+    """Column values of the motion variables for ``p.warm_start`` (None when the
+    trajectories do not fit the model: a robot missing, a move the model pruned)."""
+    ws = model.p.warm_start
+    if not ws:
+        return None
+    T = model.T
+    out: dict[int, float] = {}
+    counts: dict[tuple[int, int, str, str], int] = defaultdict(int)
+    for r in model.robots:
+        traj = ws.get(r)
+        if not traj or traj[0] != model.pos[r] or len(traj) > T + 1:
+            return None
+        traj = list(traj) + [traj[-1]] * (T + 1 - len(traj))
+        c = model.class_of[r]
+        if c.static:
+            if any(s != c.start for s in traj):
+                return None
+            continue
+        for t in range(T):
+            counts[c.idx, t, traj[t], traj[t + 1]] += 1
+    for key, n in counts.items():
+        var = model.x.get(key)
+        if var is None:
+            return None
+        out[var._cops_col] = float(n)
+    for key, var in model.x.items():
+        out.setdefault(var._cops_col, 0.0)
+    return out
+
+
+def _solve_highs(model: _Model, opts: SolverOptions, time_limit: float | None) -> _Outcome:
+    """Hand the model to HiGHS as arrays (much faster than pulp's column-by-column
+    transfer) and copy the solution back into the pulp variables."""
+    import highspy
+    import numpy as np
+
+    inf = highspy.kHighsInf
+    cols = model.vars
+    for i, v in enumerate(cols):
+        v._cops_col = i
+    n = len(cols)
+    lp = highspy.HighsLp()
+    lp.num_col_ = n
+    lp.num_row_ = len(model.rows)
+    cost = np.zeros(n)
+    for v, a in model.objective.items():
+        cost[v._cops_col] += a
+    lp.col_cost_ = cost
+    lp.offset_ = float(model.objective.constant or 0.0)
+    col_lower = np.array([-inf if v.lowBound is None else float(v.lowBound) for v in cols], dtype=float)
+    col_upper = np.array([inf if v.upBound is None else float(v.upBound) for v in cols], dtype=float)
+    lp.col_lower_, lp.col_upper_ = col_lower, col_upper
+    starts, index, value, lower, upper = [0], [], [], [], []
+    for row in model.rows:
+        for v, a in row.items():
+            if a:
+                index.append(v._cops_col)
+                value.append(a)
+        starts.append(len(index))
+        rhs = -float(row.constant or 0.0)
+        if row.sense == pulp.LpConstraintEQ:
+            lower.append(rhs)
+            upper.append(rhs)
+        elif row.sense == pulp.LpConstraintLE:
+            lower.append(-inf)
+            upper.append(rhs)
+        else:
+            lower.append(rhs)
+            upper.append(inf)
+    lp.row_lower_ = np.array(lower, dtype=float)
+    lp.row_upper_ = np.array(upper, dtype=float)
+    lp.a_matrix_.format_ = highspy.MatrixFormat.kRowwise
+    lp.a_matrix_.num_col_ = n
+    lp.a_matrix_.num_row_ = len(model.rows)
+    lp.a_matrix_.start_ = np.array(starts, dtype=np.int32)
+    lp.a_matrix_.index_ = np.array(index, dtype=np.int32)
+    lp.a_matrix_.value_ = np.array(value, dtype=float)
+    kint, kcont = highspy.HighsVarType.kInteger, highspy.HighsVarType.kContinuous
+    lp.integrality_ = [kint if v.cat == pulp.LpInteger else kcont for v in cols]
+    lp.sense_ = highspy.ObjSense.kMaximize
+    h = highspy.Highs()
+    h.setOptionValue("output_flag", False)
+    h.setOptionValue("threads", int(opts.threads or 1))
+    h.setOptionValue("random_seed", 0)
+    if opts.mip_gap is not None:
+        h.setOptionValue("mip_rel_gap", float(opts.mip_gap))
+    # presolve's probing can take the whole time limit on these models (HiGHS's own advice)
+    h.setOptionValue("presolve_rule_off", _PRESOLVE_NO_PROBING)
+    h.passModel(lp)
+    M = highspy.HighsModelStatus
+    t_start = time.perf_counter()
+
+    def remaining() -> float | None:
+        return None if time_limit is None else max(time_limit - (time.perf_counter() - t_start), 0.01)
+
+    warm = _warm_values(model)
+    start = None
+    if warm:
+        # complete the given trajectories first (motion fixed: an easy problem), then hand
+        # the whole solution to the real solve as its first incumbent
+        idx = np.fromiter(warm.keys(), dtype=np.int32, count=len(warm))
+        val = np.fromiter(warm.values(), dtype=float, count=len(warm))
+        h.changeColsBounds(len(warm), idx, val, val)
+        lim = remaining()
+        h.setOptionValue("time_limit", 1e30 if lim is None else float(max(0.5 * lim, 0.01)))
+        h.run()
+        if h.getInfo().primal_solution_status == 2:
+            start = list(h.getSolution().col_value)
+        h.changeColsBounds(len(warm), idx, col_lower[idx], col_upper[idx])
+    lim = remaining()
+    h.setOptionValue("time_limit", 1e30 if lim is None else float(lim))
+    if start is not None:
+        sol = highspy.HighsSolution()
+        sol.col_value = start
+        sol.value_valid = True
+        h.setSolution(sol)
+    stall = opts.stall_time_s if not model.p.feasibility_only else None
+    if stall:
+        last = [time.perf_counter() if start is not None else None]
+
+        def improved(_event) -> None:
+            last[0] = time.perf_counter()
+
+        def check(event) -> None:
+            t = last[0]
+            if t is not None and time.perf_counter() - t > max(stall, 0.5 * (t - t_start)):
+                event.interrupt()
+
+        h.cbMipImprovingSolution.subscribe(improved)
+        h.cbMipInterrupt.subscribe(check)
+        h.cbSimplexInterrupt.subscribe(check)
+    h.run()
+    status = h.getModelStatus()
+    info = h.getInfo()
+    if status in (M.kInfeasible, M.kUnboundedOrInfeasible):
+        return _Outcome("infeasible")
+    values = None
+    gap = float(info.mip_gap) if math.isfinite(info.mip_gap) else None
+    if info.primal_solution_status == 2:
+        values = h.getSolution().col_value
+    elif start is not None:  # nothing better than the completed warm start in time
+        values, gap, status = start, None, M.kTimeLimit
+    if values is None:
+        return _Outcome("unknown", timed_out=status == M.kTimeLimit)
+    for v, x in zip(cols, values):
+        v.varValue = x
+    if status == M.kOptimal:
+        return _Outcome("optimal", 0.0 if gap is None else gap)
+    return _Outcome("feasible", gap, timed_out=status == M.kTimeLimit)
+
+
+def _solve_pulp(model: _Model, opts: SolverOptions, time_limit: float | None) -> _Outcome:
+    o = SolverOptions(time_limit_s=time_limit, mip_gap=opts.mip_gap, solver=opts.solver, threads=opts.threads)
+    _name, solver = _make_solver(o)
+    for row in model.rows:
+        model.lp += row
+    model.lp += model.objective
+    t0 = time.perf_counter()
+    model.lp.solve(solver)
+    status, sol_status = model.lp.status, model.lp.sol_status
+    if sol_status == pulp.LpSolutionInfeasible or status == pulp.LpStatusInfeasible:
+        return _Outcome("infeasible")
+    if sol_status == pulp.LpSolutionOptimal:
+        return _Outcome("optimal", 0.0)
+    timed_out = time_limit is not None and time.perf_counter() - t0 >= 0.9 * time_limit
+    if sol_status == pulp.LpSolutionIntegerFeasible:
+        return _Outcome("feasible", None, timed_out)
+    return _Outcome("unknown", timed_out=timed_out)
+
+
+def solve_connectivity(p: ConnectivityProblem, *, time_limit_s: float | None = None) -> Plan | None:
     """Solve ``p`` at its horizon: the plan, or None when infeasible at this horizon.
 
-    Raises :class:`SolverTimeout` when the time limit passes before any plan is found.
+    ``time_limit_s`` overrides ``p.options.time_limit_s`` for this solve. When the
+    limit passes with a plan in hand, that plan is returned (``meta["status"]`` is
+    "feasible" and ``meta["gap"]`` its optimality gap, None when unknown). Raises
+    :class:`SolverTimeout` when the limit passes before any plan is found.
     """
     t0 = time.perf_counter()
     for r, s in p.positions.items():
@@ -627,43 +874,34 @@ def solve_connectivity(p: ConnectivityProblem) -> Plan | None:
     model.build()
     if model.infeasible_reason:
         return None
-    build_s = time.perf_counter() - t0
-    solver_name, solver = _make_solver(p.options)
-    if not model.lp.variables():
-        status, sol_status = 1, 1
+    limit = p.options.time_limit_s if time_limit_s is None else time_limit_s
+    solver_name = available_solver(p.options.solver)
+    if not model.vars:
+        out = _Outcome("optimal", 0.0)
+    elif solver_name == "highs":
+        out = _solve_highs(model, p.options, limit)
     else:
-        model.lp.solve(solver)
-        status, sol_status = model.lp.status, model.lp.sol_status
-    solve_s = time.perf_counter() - t0 - build_s
-    if sol_status in (pulp.LpSolutionInfeasible,) or status == pulp.LpStatusInfeasible:
+        out = _solve_pulp(model, p.options, limit)
+    if out.status == "infeasible":
         return None
-    if sol_status not in (pulp.LpSolutionOptimal, pulp.LpSolutionIntegerFeasible):
-        if p.options.time_limit_s is not None and solve_s >= 0.9 * p.options.time_limit_s:
-            raise SolverTimeout(f"no plan found within the time limit of {p.options.time_limit_s:g} s "
-                                f"(horizon T={p.horizon})")
+    if out.status == "unknown":
+        if out.timed_out:
+            raise SolverTimeout(f"no plan found within the time limit of {limit:g} s (horizon T={p.horizon})")
         return None
-    optimal = sol_status == pulp.LpSolutionOptimal
-    gap = 0.0 if optimal else None
-    if solver_name == "highs" and model.lp.variables():
-        try:
-            info = model.lp.solverModel.getInfo()
-            gap = 0.0 if optimal else float(info.mip_gap)
-        except Exception:  # pragma: no cover
-            pass
     plan = _extract(model)
     reward = sum(_val(v) * c for v, c in _terms(model.reward_terms))
     cost = sum(_val(v) * c for v, c in _terms(model.cost_terms))
     plan.meta.update({
-        "status": "optimal" if optimal else "feasible",
-        "gap": None if gap is None else round(gap, 6),
+        "status": out.status,
+        "gap": None if out.gap is None else round(out.gap, 6),
         "objective": round(reward - cost, 6),
         "reward": round(reward, 6),
         "cost": round(plan_cost(p.network, plan), 6),
         "ilp_cost": round(cost, 6),
         "solver": solver_name,
         "solve_time_s": round(time.perf_counter() - t0, 4),
-        "variables": len(model.lp.variables()),
-        "constraints": model.lp.numConstraints(),
+        "variables": len(model.vars),
+        "constraints": len(model.rows),
     })
     return plan
 
