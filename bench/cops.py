@@ -4,11 +4,14 @@ team size, with and without clustering.
 Scenario per cell: a tunnel network from ``tunnel_network_graph(n, seed)``, the base
 station at s0, half the robots at the base and the rest spread over the tunnels (as
 after earlier cycles), frontiers at every dead end. Each integer program is bounded by
-``--time-limit`` seconds (feasibility probes of the horizon search by ``--probe-limit``)
-and a cell whose cycle runs longer than ``--cell-limit`` is skipped for larger teams.
-Printed: wall time of the cycle (median of ``--repeats`` runs where a run is cheap),
-the horizons, the worst optimality gap reported by the solver (None: unknown), and
-whether every plan passes the validator.
+``--time-limit`` seconds (feasibility probes of the horizon search by ``--probe-limit``),
+the whole cycle by ``--total-limit`` (each program's limit is cut to its share of the
+time left), and a cell whose cycle runs longer than ``--cell-limit`` is skipped for
+larger teams. Printed per cell, for the median of ``--repeats`` runs (the machine may
+be shared): wall time of the cycle (with the fastest and slowest run), whether
+``clustering="auto"`` would cluster, the horizons, the worst optimality gap reported
+by the solver (None: unknown), and whether every plan of every run passes the
+validator.
 
     .venv/bin/python bench/cops.py            # the whole table, < 15 min on 2 cores
     .venv/bin/python bench/cops.py --sizes 100 --robots 10
@@ -18,12 +21,12 @@ from __future__ import annotations
 import argparse
 import random
 import shlex
-import statistics
 import sys
 import time
 
 from delve.planners.cops import (PlanningError, Robot, SolverOptions, available_solver, plan_cycle,
                                  tunnel_network_graph, validate_plan)
+from delve.planners.cops.clustering import should_cluster
 from delve.planners.cops.network import dead_ends
 
 
@@ -59,16 +62,16 @@ def main(argv=None) -> int:
                     help="seconds for the whole cycle (each program's limit is cut to its share)")
     ap.add_argument("--cell-limit", type=float, default=40.0,
                     help="skip larger teams on a size once a cycle took this long")
-    ap.add_argument("--repeats", type=int, default=3, help="runs per cell when a run takes < 2 s")
+    ap.add_argument("--repeats", type=int, default=3, help="runs per cell (the median run is shown)")
     ap.add_argument("--seed", type=int, default=1)
     args = ap.parse_args(argv)
     print("command:", " ".join(shlex.quote(a) for a in [sys.executable] + sys.argv))
     print(f"solver: {available_solver()}; per-solve limit {args.time_limit:g} s, probe limit {args.probe_limit:g} s, "
-          f"cycle limit {args.total_limit:g} s")
+          f"cycle limit {args.total_limit:g} s; median of {args.repeats} runs per cell")
     opts = SolverOptions(time_limit_s=args.time_limit, probe_time_limit_s=args.probe_limit, mip_gap=0.01,
                          total_time_limit_s=args.total_limit)
-    header = f"{'locations':>9} {'robots':>6} {'clustering':>10} {'cycle_s':>8} {'T_pre':>5} {'T_post':>6} " \
-             f"{'clusters':>8} {'explorers':>9} {'gap':>8}  result"
+    header = f"{'locations':>9} {'robots':>6} {'clustering':>10} {'auto':>4} {'cycle_s':>8} {'min_s':>6} " \
+             f"{'max_s':>6} {'T_pre':>5} {'T_post':>6} {'clusters':>8} {'explorers':>9} {'gap':>8}  result"
     print(header)
     print("-" * len(header))
     t_all = time.perf_counter()
@@ -77,27 +80,28 @@ def main(argv=None) -> int:
             skip = False
             for r in args.robots:
                 label = "yes" if clustered else "no"
+                net = scenario(n, r, args.seed)
+                auto = "yes" if should_cluster(net, net.positions(), {net.base_station}) else "no"
                 if skip:
-                    print(f"{n:>9} {r:>6} {label:>10} {'-':>8} {'-':>5} {'-':>6} {'-':>8} {'-':>9} {'-':>8}  "
-                          f"skipped (a smaller team already took > {args.cell_limit:g} s)")
+                    print(f"{n:>9} {r:>6} {label:>10} {auto:>4} {'-':>8} {'-':>6} {'-':>6} {'-':>5} {'-':>6} {'-':>8} "
+                          f"{'-':>9} {'-':>8}  skipped (a smaller team already took > {args.cell_limit:g} s)")
                     continue
-                walls = []
-                wall, cyc, result = run_cell(n, r, clustered, opts, args.seed)
-                walls.append(wall)
-                if cyc is not None and wall < 2.0:
-                    for _ in range(args.repeats - 1):
-                        walls.append(run_cell(n, r, clustered, opts, args.seed)[0])
-                med = statistics.median(walls)
+                runs = [run_cell(n, r, clustered, opts, args.seed) for _ in range(max(args.repeats, 1))]
+                walls = sorted(w for w, _c, _res in runs)
+                wall, cyc, result = sorted(runs, key=lambda run: run[0])[len(runs) // 2]
+                if any(res == "INVALID" for _w, _c, res in runs):
+                    result = "INVALID"
                 if cyc is None:
-                    print(f"{n:>9} {r:>6} {label:>10} {med:>8.2f} {'-':>5} {'-':>6} {'-':>8} {'-':>9} {'-':>8}  "
-                          f"no plan: {result}")
+                    print(f"{n:>9} {r:>6} {label:>10} {auto:>4} {wall:>8.2f} {walls[0]:>6.2f} {walls[-1]:>6.2f} "
+                          f"{'-':>5} {'-':>6} {'-':>8} {'-':>9} {'-':>8}  no plan: {result}")
                 else:
                     gap = cyc.meta.get("gap")
                     gap_s = "None" if gap is None else f"{gap:.3f}"
-                    print(f"{n:>9} {r:>6} {label:>10} {med:>8.2f} {cyc.pre.horizon:>5} {cyc.post.horizon:>6} "
-                          f"{cyc.meta.get('clusters', 1):>8} {len(cyc.pre.explore):>9} {gap_s:>8}  {result}")
+                    print(f"{n:>9} {r:>6} {label:>10} {auto:>4} {wall:>8.2f} {walls[0]:>6.2f} {walls[-1]:>6.2f} "
+                          f"{cyc.pre.horizon:>5} {cyc.post.horizon:>6} {cyc.meta.get('clusters', 1):>8} "
+                          f"{len(cyc.pre.explore):>9} {gap_s:>8}  {result}")
                 sys.stdout.flush()
-                if med > args.cell_limit:
+                if wall > args.cell_limit:
                     skip = True
     print(f"total {time.perf_counter() - t_all:.0f} s")
     return 0

@@ -18,7 +18,8 @@ their locations s_t, then move to s_{t+1}):
   bounded by the robots that take the arc) and between robots along communication
   arcs of one step (bounded by robots present at both ends, and by a sender that
   holds m). One commodity per connectivity constraint with a single sink (every
-  source supplies one unit, the sink absorbs them all), one commodity per source
+  source location supplies one unit per label, the sink absorbs them all: the flow's
+  path decomposition routes every source to the sink), one commodity per source
   location otherwise. Conservation at every time-expanded node makes each sink's
   information come from a real source, with no communication cycle. The
   communication cost C̃ is paid per label sent over a communication edge (the
@@ -33,6 +34,14 @@ their locations s_t, then move to s_{t+1}):
 * Extensions: static robots have fixed locations; collision robots never share a
   collision location nor traverse the same edge at once; only capable robots count
   for frontier rewards.
+
+Solving. With HiGHS the model goes to the solver as arrays, with presolve's probing
+off (it can take the whole time limit on these models). A warm start (trajectories,
+e.g. a greedy plan) is first completed with the motion fixed and then handed over as
+the first incumbent, so a solve stopped by its time limit, or because its plan has
+stopped improving (``SolverOptions.stall_time_s``), returns at least that plan, with
+its optimality gap. Every iteration over the network is in name order, so the same
+problem gives the same model whatever order its graphs were built in.
 
 The solver returns location-level flows; :func:`reconstruct_communications` turns them
 into robot-level tuples (t, r, r', b) through each location's communication leader
@@ -55,6 +64,8 @@ from .plan import MASTER, Communication, Plan, Requirement
 _EPS = 1e-6
 #: HiGHS presolve_rule_off bit that turns probing off.
 _PRESOLVE_NO_PROBING = 1 << 15
+#: However long building the model took, the solver gets at least this long (s).
+_MIN_SOLVER_TIME_S = 0.2
 
 
 class PlanningError(Exception):
@@ -861,7 +872,8 @@ def _solve_pulp(model: _Model, opts: SolverOptions, time_limit: float | None) ->
 def solve_connectivity(p: ConnectivityProblem, *, time_limit_s: float | None = None) -> Plan | None:
     """Solve ``p`` at its horizon: the plan, or None when infeasible at this horizon.
 
-    ``time_limit_s`` overrides ``p.options.time_limit_s`` for this solve. When the
+    ``time_limit_s`` overrides ``p.options.time_limit_s`` for this call (building the
+    model included; the solver gets at least a fraction of a second). When the
     limit passes with a plan in hand, that plan is returned (``meta["status"]`` is
     "feasible" and ``meta["gap"]`` its optimality gap, None when unknown). Raises
     :class:`SolverTimeout` when the limit passes before any plan is found.
@@ -875,6 +887,8 @@ def solve_connectivity(p: ConnectivityProblem, *, time_limit_s: float | None = N
     if model.infeasible_reason:
         return None
     limit = p.options.time_limit_s if time_limit_s is None else time_limit_s
+    if limit is not None:  # the limit bounds the whole call, model building included
+        limit = max(limit - (time.perf_counter() - t0), min(limit, _MIN_SOLVER_TIME_S))
     solver_name = available_solver(p.options.solver)
     if not model.vars:
         out = _Outcome("optimal", 0.0)

@@ -756,7 +756,10 @@ def solve_post_exploration(network: MCNetwork, *, sources: Iterable[str], positi
         best_T, bad, warm = T_h, lo - 1, greedy
         while best_T - bad > 1 and (budget.left() is None or budget.left() > 4 * MIN_SOLVE_TIME_S):
             mid = (best_T + bad) // 2
-            found = probe(mid)
+            try:
+                found = make(mid, probe=True, limit=budget.limit(share=0.25, probe=True))
+            except SolverTimeout:
+                break  # too hard to tell in time: larger horizons are harder still
             if found is None:
                 bad = mid
             else:
@@ -780,7 +783,7 @@ def solve_post_exploration(network: MCNetwork, *, sources: Iterable[str], positi
     carry_home = max(carry_home, lo)
     T = int(min(max(carry_home, lo), hi)) if carry_home < math.inf else hi
     found = probe(T)
-    while found is None and T < hi:
+    while found is None and T < hi and (budget.left() is None or budget.left() > MIN_SOLVE_TIME_S):
         T += 1
         found = probe(T)
     if found is None:
@@ -790,7 +793,7 @@ def solve_post_exploration(network: MCNetwork, *, sources: Iterable[str], positi
             raise InfeasibleProblem(_diagnose_post(make, srcs, bounds, hi))
         return found
     best_T, bad = T, lo - 1
-    while best_T - bad > 1:
+    while best_T - bad > 1 and (budget.left() is None or budget.left() > 4 * MIN_SOLVE_TIME_S):
         mid = (best_T + bad) // 2
         attempt = probe(mid)
         if attempt is None:
