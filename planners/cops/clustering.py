@@ -38,7 +38,7 @@ from .ilp import InfeasibleProblem, PlanningError, SolverOptions
 from .network import MCNetwork
 from .plan import Communication, CyclePlan, ExplorationTask, Plan, Requirement
 from .problems import (DEFAULT_MIN_EXPLORATION_STEPS, PRE_SHARE, FrontierReward, _Budget, _masters,
-                       _robot_sets, solve_post_exploration, solve_pre_exploration)
+                       _robot_sets, greedy_pre_plan, solve_post_exploration, solve_pre_exploration)
 
 #: Default largest number of locations in a cluster before it is cut.
 DEFAULT_MAX_CLUSTER_LOCATIONS = 24
@@ -188,15 +188,27 @@ def build_clusters(network: MCNetwork, positions: Mapping[str, str], frontiers: 
     return struct
 
 
-def should_cluster(network: MCNetwork, positions: Mapping[str, str], masters: Iterable[str]) -> bool:
-    """Whether the one-shot problem looks too large: robot classes x horizon x arcs."""
-    occupied = {s for r, s in positions.items() if not (r in network.robots and network.robots[r].static)}
+def should_cluster(network: MCNetwork, positions: Mapping[str, str], masters: Iterable[str], *,
+                   frontiers: Iterable[str] | None = None, static: Iterable[str] | None = None,
+                   explorers: Iterable[str] | None = None, reward: FrontierReward | None = None) -> bool:
+    """Whether the one-shot problem looks too large: robot classes (occupied
+    locations) x horizon x arcs, the horizon that of a greedy pre-exploration plan
+    (the depth of the network when there is none)."""
+    st = set(network.static_robots() if static is None else static) & set(positions)
+    occupied = {s for r, s in positions.items() if r not in st}
     if network.base is None or network.base not in network:
         return False
-    dist = _tree_distances(network, network.base)
-    horizon = max(dist.values(), default=0)
+    ex = set(network.explorers() if explorers is None else explorers) & set(positions) - st
+    fr = [s for s in sorted(network.frontiers if frontiers is None else frontiers) if s in network]
+    marg = (reward or FrontierReward()).marginals(len(ex))
+    greedy = greedy_pre_plan(network, positions, set(masters) & set(positions), st, ex, {s: marg for s in fr}) \
+        if fr and ex else None
+    if greedy is not None:
+        horizon = max(len(tr) for tr in greedy.values()) - 1
+    else:
+        horizon = max(_tree_distances(network, network.base).values(), default=0)
     arcs = network.mobility.number_of_edges() + len(network)
-    return len(occupied) * horizon * arcs > AUTO_CLUSTER_SIZE
+    return len(occupied) * max(horizon, 1) * arcs > AUTO_CLUSTER_SIZE
 
 
 def _nearest(network: MCNetwork, robots: list[str], positions: Mapping[str, str], target: str,

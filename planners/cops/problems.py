@@ -858,7 +858,8 @@ def plan_cycle(network: MCNetwork, *, positions: Mapping[str, str] | None = None
     opts = options or SolverOptions()
     pos, st, ex = _robot_sets(network, positions, static, explorers)
     ms = _masters(network, pos, masters)
-    use = should_cluster(network, pos, ms) if clustering == "auto" else bool(clustering)
+    use = should_cluster(network, pos, ms, frontiers=frontiers, static=st, explorers=ex, reward=reward) \
+        if clustering == "auto" else bool(clustering)
     if use:
         kw = {} if max_cluster_locations is None else {"max_cluster_locations": max_cluster_locations}
         cyc = plan_cycle_clustered(network, positions=pos, frontiers=frontiers, masters=ms, reward=reward,

@@ -85,3 +85,24 @@ def test_infeasible_problems_say_why_in_one_line():
         solve_post_exploration(net, sources=["r2"], masters=["base", "r2"])
     assert "no route to the base" in str(err.value) and "r2" in str(err.value)
     assert "\n" not in str(err.value)
+
+
+def test_a_mobile_sink_that_is_its_own_only_source_still_goes_to_its_final_location():
+    # a cluster's sub-master that explored itself must still carry its information up
+    net = fork(team(1))
+    pos = {"base": "s0", "r1": "a3"}
+    plan = solve_post_exploration(net, sources=["r1"], positions=pos, masters=["r1"], base_station="r1",
+                                  static=["base"], static_sink=False, sink_final_location="s1")
+    assert validate_plan(net, plan) == []
+    assert plan.trajectories["r1"][-1] == "s1" and plan.horizon == 3
+
+
+def test_greedy_plans_bound_the_horizon_and_warm_start_the_solver():
+    net = fork(team(4))
+    cyc = plan_cycle(net, clustering=False, options=SolverOptions(time_limit_s=2, total_time_limit_s=4))
+    assert validate_plan(net, cyc.pre) == []
+    # trimmed after the last action: the last step moves someone or sends something
+    T = cyc.pre.horizon
+    last_moves = any(tr[T - 1] != tr[T] for tr in cyc.pre.trajectories.values())
+    assert last_moves or any(c.t == T for c in cyc.pre.communications)
+    assert cyc.pre.meta["status"] in ("optimal", "feasible") and cyc.meta["solve_time_s"] < 8
