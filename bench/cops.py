@@ -83,8 +83,8 @@ def main(argv=None) -> int:
                 net = scenario(n, r, args.seed)
                 auto = "yes" if should_cluster(net, net.positions(), {net.base_station}) else "no"
                 if skip:
-                    print(f"{n:>9} {r:>6} {label:>10} {auto:>4} {'-':>8} {'-':>6} {'-':>6} {'-':>5} {'-':>6} {'-':>8} "
-                          f"{'-':>9} {'-':>8}  skipped (a smaller team already took > {args.cell_limit:g} s)")
+                    print(f"{n:>9} {r:>6} {label:>10} {auto:>4} {'-':>8} {'-':>6} {'-':>6} {'-':>5} {'-':>6} "
+                          f"{'-':>8} {'-':>9} {'-':>8}  skipped (a smaller team already took > {args.cell_limit:g} s)")
                     continue
                 runs = [run_cell(n, r, clustered, opts, args.seed) for _ in range(max(args.repeats, 1))]
                 walls = sorted(w for w, _c, _res in runs)
@@ -92,13 +92,13 @@ def main(argv=None) -> int:
                 if any(res == "INVALID" for _w, _c, res in runs):
                     result = "INVALID"
                 if cyc is None:
-                    print(f"{n:>9} {r:>6} {label:>10} {auto:>4} {wall:>8.2f} {walls[0]:>6.2f} {walls[-1]:>6.2f} "
-                          f"{'-':>5} {'-':>6} {'-':>8} {'-':>9} {'-':>8}  no plan: {result}")
+                    print(f"{n:>9} {r:>6} {label:>10} {auto:>4} {wall:>8.2f} {walls[0]:>6.2f} "
+                          f"{walls[-1]:>6.2f} {'-':>5} {'-':>6} {'-':>8} {'-':>9} {'-':>8}  no plan: {result}")
                 else:
                     gap = cyc.meta.get("gap")
                     gap_s = "None" if gap is None else f"{gap:.3f}"
-                    print(f"{n:>9} {r:>6} {label:>10} {auto:>4} {wall:>8.2f} {walls[0]:>6.2f} {walls[-1]:>6.2f} "
-                          f"{cyc.pre.horizon:>5} {cyc.post.horizon:>6} {cyc.meta.get('clusters', 1):>8} "
+                    print(f"{n:>9} {r:>6} {label:>10} {auto:>4} {wall:>8.2f} {walls[0]:>6.2f} "
+                          f"{walls[-1]:>6.2f} {cyc.pre.horizon:>5} {cyc.post.horizon:>6} {cyc.meta.get('clusters', 1):>8} "
                           f"{len(cyc.pre.explore):>9} {gap_s:>8}  {result}")
                 sys.stdout.flush()
                 if wall > args.cell_limit:

@@ -201,8 +201,10 @@ def should_cluster(network: MCNetwork, positions: Mapping[str, str], masters: It
     ex = set(network.explorers() if explorers is None else explorers) & set(positions) - st
     fr = [s for s in sorted(network.frontiers if frontiers is None else frontiers) if s in network]
     marg = (reward or FrontierReward()).marginals(len(ex))
-    greedy = greedy_pre_plan(network, positions, set(masters) & set(positions), st, ex, {s: marg for s in fr}) \
-        if fr and ex else None
+    greedy = None
+    if fr and ex:
+        greedy = greedy_pre_plan(network, positions, set(masters) & set(positions), st, ex,
+                                 {s: marg for s in fr})
     if greedy is not None:
         horizon = max(len(tr) for tr in greedy.values()) - 1
     else:
@@ -294,7 +296,8 @@ def plan_cycle_clustered(network: MCNetwork, *, positions: Mapping[str, str] | N
         "gap": _gap([pre, post])})
 
 
-def _solve_all(jobs: list[tuple[str, float, Callable[[SolverOptions], Plan]]], opts: SolverOptions) -> dict[str, Plan]:
+def _solve_all(jobs: list[tuple[str, float, Callable[[SolverOptions], Plan]]],
+               opts: SolverOptions) -> dict[str, Plan]:
     """Run independent cluster problems, ``opts.workers`` at once (the solver releases
     the interpreter while it works). A job (name, weight, solve) may use the share of
     the time left that its weight has among the jobs not yet started (times the
@@ -433,8 +436,8 @@ def _clustered_post(network, cs: ClusterStructure, pre: Plan, post_pos, post_mas
             labels |= set(holdings.get(r, {r}))
         carries[name] = labels
 
-        def solve(o: SolverOptions, locs=locs, sources=sources, sub_positions=sub_positions, holdings=holdings,
-                  statics=statics, sink=sink, final=final, c=c) -> Plan:
+        def solve(o: SolverOptions, locs=locs, sources=sources, sub_positions=sub_positions,
+                  holdings=holdings, statics=statics, sink=sink, final=final, c=c) -> Plan:
             return solve_post_exploration(
                 network.subnetwork(locs), sources=sources, positions=sub_positions,
                 masters=(post_masters & set(sub_positions)) | set(holdings), base_station=sink,

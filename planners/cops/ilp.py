@@ -635,8 +635,8 @@ class _Model:
                     if not terms:
                         continue
                     if n0 >= 2:  # robots that start together may stay; nobody else may come
-                        arrivals = [x[c.idx, t - 1, u, v] for c in col for u in sorted(net.mobility.predecessors(v))
-                                    if (c.idx, t - 1, u, v) in x]
+                        arrivals = [x[c.idx, t - 1, u, v] for c in col
+                                    for u in sorted(net.mobility.predecessors(v)) if (c.idx, t - 1, u, v) in x]
                         if arrivals:
                             self.le(arrivals, 0)
                     else:

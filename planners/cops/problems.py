@@ -301,7 +301,8 @@ def greedy_pre_plan(network: MCNetwork, positions: Mapping[str, str], masters: I
                         best = (key, r, s, None)
         # robots without m: a courier brings m first
         for u in gated:
-            waiting = [q for q in g.robots if g.pos[q] == u and q in rew and q not in g.free and len(g.traj[q]) == 1]
+            waiting = [q for q in g.robots
+                       if g.pos[q] == u and q in rew and q not in g.free and len(g.traj[q]) == 1]
             if not waiting:
                 continue
             couriers = []
@@ -310,8 +311,8 @@ def greedy_pre_plan(network: MCNetwork, positions: Mapping[str, str], masters: I
                     continue
                 got = g.into_range(c, u)
                 if got is not None:
-                    couriers.append((got[0], sum(network.mobility_cost(a, b) for a, b in zip(got[1], got[1][1:])),
-                                     c, got[1]))
+                    cost = sum(network.mobility_cost(a, b) for a, b in zip(got[1], got[1][1:]))
+                    couriers.append((got[0], cost, c, got[1]))
             if not couriers:
                 continue
             arrival, c_cost, c, path = min(couriers, key=lambda e: (e[0], e[1], e[2]))
