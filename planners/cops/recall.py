@@ -3,8 +3,8 @@
 Every robot that m can reach (robots move only once they hold m, so m travels over
 communication edges and with robots that already hold it) is brought to the base.
 It is a reward problem like Problem 1: each robot holding m at the base at T earns
-``home_reward``, minus the plan's cost C(Π). The horizon is the smallest at which
-as many robots get home as at the largest horizon tried.
+``home_reward``, minus the plan's cost C(Π). The horizon grows from the farthest
+robot's distance until every robot gets home or two longer horizons bring no more.
 """
 from __future__ import annotations
 
@@ -55,17 +55,18 @@ def solve_recall(network: MCNetwork, *, positions: Mapping[str, str], masters: I
     def home(plan: Plan | None) -> int:
         return -1 if plan is None else sum(1 for r in mobile if plan.location(r, plan.horizon) == base)
 
-    best = solve(upper)
+    lower = max(hops[positions[r]] for r in away)
+    best, stalled = None, 0  # grow the horizon until everyone is home or it stops helping
+    for T in range(lower, upper + 1, 2):
+        plan = solve(T)
+        if home(plan) > home(best):
+            best, stalled = plan, 0
+        else:
+            stalled += 1
+        if home(best) == len(mobile) or stalled >= 2:
+            break
     if best is None:
         raise InfeasibleProblem(f"no recall plan within horizon T={upper}")
-    lo, hi = 0, upper  # the smallest horizon that brings as many home
-    while lo < hi:
-        mid = (lo + hi) // 2
-        plan = solve(mid)
-        if home(plan) >= home(best):
-            best, hi = plan, mid
-        else:
-            lo = mid + 1
     best.meta["stranded"] = sorted(r for r in mobile if best.location(r, best.horizon) != base)
     best.explore = {}
     return best
