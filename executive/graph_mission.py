@@ -8,7 +8,6 @@ fraction of locations explored, and the report adds the COPS plans.
 from __future__ import annotations
 
 import statistics
-from collections import deque
 from dataclasses import replace
 from typing import Any
 
@@ -16,13 +15,10 @@ import numpy as np
 import py_trees
 from py_trees.common import Status
 
-from ..sim.clock import SimClock
 from ..sim.graph_world import GraphRadioNetwork, GraphRadioSpec, GraphRobot, GraphWorld
 from ..sim.platforms import PLATFORMS
-from .agent import Agent
-from .runner import BASE, Mission, MissionState, Sample
+from .runner import BASE, Mission, Sample
 from .scenario import Scenario
-from .tree_loader import load_tree
 
 #: Blackboard key of the base station's COPS state (skills.cops.CopsState).
 BASE_STATE_KEY = f"/{BASE}/cops"
@@ -33,13 +29,7 @@ class GraphMission(Mission):
 
     def __init__(self, scenario: Scenario, *, seed: int | None = None, duration_s: float | None = None,
                  world: GraphWorld | None = None):
-        self.scenario = scenario
-        self.seed = scenario.seed if seed is None else seed
-        self.duration_s = scenario.duration_s if duration_s is None else duration_s
-        self.world = world if world is not None else scenario.build_world(seed=self.seed)
-        scenario.check_starts(self.world)
-        self.clock = SimClock(scenario.dt_s)
-        self.state = MissionState()
+        self._begin(scenario, seed, duration_s, world)
         self.radio = GraphRadioNetwork(GraphRadioSpec(**scenario.radio), self.world,
                                        np.random.default_rng(self.seed), lambda: self.clock.now_s)
         self.robots: dict[str, GraphRobot] = {}
@@ -57,22 +47,10 @@ class GraphMission(Mission):
         base_radio = self.radio.add(BASE, lambda: base_pos)
         self.base_location = self.world.location_at(base_pos)
         team = {n: self.world.location_at(r.position) for n, r in self.robots.items()}
-        self.agents: dict[str, Agent] = {}
-        for spec in scenario.robots:
-            ctx = self._context(spec.name, self.robots[spec.name])
-            ctx.services.update(team=team, base_location=self.base_location)
-            self.agents[spec.name] = Agent(spec.name, load_tree(spec.tree, ctx), 1.0 / spec.tick_hz, ctx,
-                                           on_change=self._status_changed)
-        ctx = self._context(BASE, None)
-        ctx.services.update(radio=base_radio, team=team, base_location=self.base_location,
-                            initial_topology=self.world.explored_topology([self.base_location]))
-        self.agents[BASE] = Agent(BASE, load_tree(scenario.base_tree, ctx), 1.0 / scenario.base_tick_hz, ctx,
-                                  on_change=self._status_changed)
-        self._commands = deque(scenario.supervisor)
-        self._faults = deque(scenario.faults)
-        self.lost: set[str] = set()
+        self._add_agents({"team": team, "base_location": self.base_location}, radio=base_radio, team=team,
+                         base_location=self.base_location,
+                         initial_topology=self.world.explored_topology([self.base_location]))
         self.truth = np.arange(len(self.world))
-        self.finished_s: float | None = None
 
     # ---- the loop's hooks ---------------------------------------------------------
     def _done(self) -> bool:

@@ -66,17 +66,10 @@ class Mission:
 
     def __init__(self, scenario: Scenario, *, seed: int | None = None, duration_s: float | None = None,
                  world: World | None = None):
-        self.scenario = scenario
-        self.seed = scenario.seed if seed is None else seed
-        self.duration_s = scenario.duration_s if duration_s is None else duration_s
-        self.world = world if world is not None else scenario.build_world(seed=self.seed)
-        scenario.check_starts(self.world)
-        self.clock = SimClock(scenario.dt_s)
-        self.state = MissionState()
+        self._begin(scenario, seed, duration_s, world)
         rng = np.random.default_rng(self.seed)
         self.radio = RadioNetwork(RadioSpec(**scenario.radio), self.world, rng, lambda: self.clock.now_s)
         self.robots: dict[str, SimRobot] = {}
-        self.agents: dict[str, Agent] = {}
         self._next_scan: dict[str, float] = {}
         for i, spec in enumerate(scenario.robots):
             self.robots[spec.name] = self._robot(spec, i)
@@ -87,24 +80,41 @@ class Mission:
         self.base_map = VoxelMap(self.world.free.shape, self.world.origin, self.world.voxel_size_m)
         base_radio = self.radio.add(BASE, lambda: base_pos, breadcrumbs=0)
 
-        for spec in scenario.robots:
-            robot = self.robots[spec.name]
-            ctx = self._context(spec.name, robot)
-            self.agents[spec.name] = Agent(spec.name, load_tree(spec.tree, ctx), 1.0 / spec.tick_hz, ctx,
-                                           on_change=self._status_changed)
-        if scenario.base_tree is not None:
-            ctx = self._context(BASE, None)
-            ctx.services.update(radio=base_radio, map=self.base_map)
-            self.agents[BASE] = Agent(BASE, load_tree(scenario.base_tree, ctx), 1.0 / scenario.base_tick_hz, ctx,
-                                      on_change=self._status_changed)
+        self._add_agents(radio=base_radio, map=self.base_map)
+        reach = self.world.reachable_free(self._first_start())
+        self.truth = np.flatnonzero(reach.reshape(-1))
+
+    # ---- construction -----------------------------------------------------------
+    def _begin(self, scenario: Scenario, seed: int | None, duration_s: float | None, world: Any) -> None:
+        """What every mission holds before its robots: scenario, seed, duration, world
+        (built unless given, starts checked), clock, state, script and faults."""
+        self.scenario = scenario
+        self.seed = scenario.seed if seed is None else seed
+        self.duration_s = scenario.duration_s if duration_s is None else duration_s
+        self.world = world if world is not None else scenario.build_world(seed=self.seed)
+        scenario.check_starts(self.world)
+        self.clock = SimClock(scenario.dt_s)
+        self.state = MissionState()
+        self.agents: dict[str, Agent] = {}
         self._commands = deque(scenario.supervisor)
         self._faults = deque(scenario.faults)
         self.lost: set[str] = set()
-        reach = self.world.reachable_free(self._first_start())
-        self.truth = np.flatnonzero(reach.reshape(-1))
         self.finished_s: float | None = None
 
-    # ---- construction -----------------------------------------------------------
+    def _add_agents(self, robot_services: dict[str, Any] | None = None, **base_services: Any) -> None:
+        """One agent per robot (with ``robot_services``) and, when the scenario has a
+        base station tree, the base station's (with ``base_services``)."""
+        for spec in self.scenario.robots:
+            ctx = self._context(spec.name, self.robots[spec.name])
+            ctx.services.update(robot_services or {})
+            self.agents[spec.name] = Agent(spec.name, load_tree(spec.tree, ctx), 1.0 / spec.tick_hz, ctx,
+                                           on_change=self._status_changed)
+        if self.scenario.base_tree is not None:
+            ctx = self._context(BASE, None)
+            ctx.services.update(base_services)
+            self.agents[BASE] = Agent(BASE, load_tree(self.scenario.base_tree, ctx),
+                                      1.0 / self.scenario.base_tick_hz, ctx, on_change=self._status_changed)
+
     def _first_start(self) -> np.ndarray:
         r = next(iter(self.robots.values()))
         return r.home - np.array([0.0, 0.0, r.mobility.body_height_m])

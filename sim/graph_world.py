@@ -15,7 +15,6 @@ Robots implement the robot interface's motion and radio parts and its
 from __future__ import annotations
 
 import math
-from collections import deque
 from dataclasses import dataclass, field
 from typing import Any, Callable
 
@@ -23,7 +22,7 @@ import networkx as nx
 import numpy as np
 
 from .platforms import Platform
-from .radio import Message
+from .radio import Endpoint
 
 IDLE, FOLLOWING, ARRIVED, BLOCKED = "idle", "following", "arrived", "blocked"
 
@@ -327,40 +326,21 @@ class GraphRadioSpec:
     update_period_s: float = 1.0
 
 
-class GraphRadioEndpoint:
+class GraphRadioEndpoint(Endpoint):
     """A datagram radio (implements the robot interface's ``Radio``): a message goes
     out at the next update over one communication edge, or is lost. Reliability is the
     job of the protocol above it (COPS re-sends until acknowledged)."""
 
     def __init__(self, name: str, network: "GraphRadioNetwork"):
-        self.name = name
+        super().__init__(name, network.now_s)
         self._net = network
-        self.outbox: deque[Message] = deque()
-        self.inbox: list[Message] = []
-        self.sent = 0
-        self.delivered = 0
         self.dropped = 0
-        self.silent = False
-
-    def send(self, recipient: str, kind: str, data: Any) -> None:
-        if self.silent:
-            return
-        self.outbox.append(Message(self.name, recipient, kind, data, self._net.now_s()))
-        self.sent += 1
-
-    def receive(self) -> list[Message]:
-        out, self.inbox = self.inbox, []
-        return out
 
     def linked_to(self, other: str) -> bool:
         return self._net.linked(self.name, other)
 
     def ping(self, other: str) -> bool:
         return self._net.linked(self.name, other) and self._net.rng.random() >= self._net.spec.loss
-
-    @property
-    def pending(self) -> int:
-        return len(self.outbox)
 
 
 class GraphRadioNetwork:
@@ -386,23 +366,27 @@ class GraphRadioNetwork:
     def where(self, name: str) -> str:
         return self.world.nearest(self._positions[name]())[0]
 
-    def linked(self, a: str, b: str) -> bool:
+    def linked(self, a: str, b: str, where: dict[str, str] | None = None) -> bool:
+        """Whether ``a`` and ``b`` can talk now (``where``: their locations, if known)."""
         ea, eb = self.endpoints.get(a), self.endpoints.get(b)
         if ea is None or eb is None or ea.silent or eb.silent:
             return False
-        return self.world.can_communicate(self.where(a), self.where(b))
+        at = where.__getitem__ if where is not None else self.where
+        return self.world.can_communicate(at(a), at(b))
 
     def update(self) -> None:
         """Send every outbox once: delivered over a link unless lost, else dropped."""
         if self.now_s() + 1e-9 < self._next_update_s:
             return
         self._next_update_s = self.now_s() + self.spec.update_period_s
+        where = {name: self.where(name) for name in self.endpoints}  # once per update, not per message
         for name in sorted(self.endpoints):
             ep = self.endpoints[name]
             while ep.outbox:
                 msg = ep.outbox.popleft()
                 target = self.endpoints.get(msg.recipient)
-                if target is not None and self.linked(name, msg.recipient) and self.rng.random() >= self.spec.loss:
+                if target is not None and self.linked(name, msg.recipient, where) and \
+                        self.rng.random() >= self.spec.loss:
                     target.inbox.append(msg)
                     ep.delivered += 1
                 else:

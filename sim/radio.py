@@ -227,32 +227,45 @@ class BreadcrumbDrop:
         return self.ok
 
 
-class RadioEndpoint:
-    """One node's radio (implements the robot interface's ``Radio``)."""
+class Endpoint:
+    """What every radio has: an outbox its network sends from, an inbox it delivers
+    to, counters, and ``silent`` (a lost robot's radio sends nothing)."""
 
-    def __init__(self, name: str, network: RadioNetwork, breadcrumbs: int = 0, relay: bool = True):
+    def __init__(self, name: str, now_s: Callable[[], float]):
         self.name = name
-        self._net = network
+        self._now_s = now_s
         self.outbox: deque[Message] = deque()
         self.inbox: list[Message] = []
         self.sent = 0
         self.delivered = 0
-        self.pings = 0
-        self.pings_answered = 0
-        self.breadcrumbs = int(breadcrumbs)
-        self.breadcrumbs_deployed = 0
-        self.relay = bool(relay)
         self.silent = False
 
     def send(self, recipient: str, kind: str, data: Any) -> None:
         if self.silent:
             return
-        self.outbox.append(Message(self.name, recipient, kind, data, self._net.now_s()))
+        self.outbox.append(Message(self.name, recipient, kind, data, self._now_s()))
         self.sent += 1
 
     def receive(self) -> list[Message]:
         out, self.inbox = self.inbox, []
         return out
+
+    @property
+    def pending(self) -> int:
+        return len(self.outbox)
+
+
+class RadioEndpoint(Endpoint):
+    """One node's radio on the WiFi mesh (implements the robot interface's ``Radio``)."""
+
+    def __init__(self, name: str, network: RadioNetwork, breadcrumbs: int = 0, relay: bool = True):
+        super().__init__(name, network.now_s)
+        self._net = network
+        self.pings = 0
+        self.pings_answered = 0
+        self.breadcrumbs = int(breadcrumbs)
+        self.breadcrumbs_deployed = 0
+        self.relay = bool(relay)
 
     def linked_to(self, other: str) -> bool:
         """Whether a route (direct or through the mesh) to ``other`` exists right now."""
@@ -265,10 +278,6 @@ class RadioEndpoint:
     def deploy_breadcrumb(self, position: np.ndarray) -> BreadcrumbDrop:
         """Drop one of this radio's breadcrumbs at ``position``."""
         return self._net.deploy_breadcrumb(self.name, position)
-
-    @property
-    def pending(self) -> int:
-        return len(self.outbox)
 
 
 class RadioNetwork:

@@ -253,7 +253,7 @@ class SolveCOPS(CopsSkill):
         base_loc = st.base_location = self.ctx.services["base_location"]
         team = self.ctx.services["team"]
         kn = st.knowledge
-        positions = self._positions(st, team)
+        positions, returning = self._positions(st, team)
         try:
             net = team_network(kn.topology, base_loc, self.ctx.name, positions, spacing_m=self.p["spacing_m"])
             positions = net.positions()
@@ -270,7 +270,7 @@ class SolveCOPS(CopsSkill):
                 raise PlanningError(f"{len(frontiers)} frontiers left but no robot that m can reach is "
                                     f"sent to one (robots out of radio reach of the base and of each other)")
             cyc.meta["explored"] = sorted(kn.topology.explored)
-            cyc.meta["returning"] = self._returning
+            cyc.meta["returning"] = returning
         except (PlanningError, ValueError) as err:
             self.event("cops_no_plan", cycle=st.cycle + 1, reason=str(err))
             self.feedback_message = str(err)
@@ -299,20 +299,18 @@ class SolveCOPS(CopsSkill):
                    clustered=bool(cyc.meta.get("clustered")), valid=True)
         return Status.SUCCESS
 
-    _returning: list[str] = []
-
-    def _positions(self, st: CopsState, team: dict[str, str]) -> dict[str, str]:
-        """Where the last plan left each robot not declared lost; a robot the last
-        plan did not reach goes back to the base by the standing order of m."""
+    def _positions(self, st: CopsState, team: dict[str, str]) -> tuple[dict[str, str], list[str]]:
+        """Where the last plan left each robot not declared lost, and the robots that
+        go back to the base by the standing order of m (the last plan did not reach
+        them, or no new plan can)."""
         alive = {r: s for r, s in team.items() if r not in st.knowledge.lost}
         if st.plan is None:
-            return alive
+            return alive, []
         last = st.plan.post.final_positions()
         reached = st.plan.pre.master_receivers() | st.plan.post.master_receivers()
         pos = {r: last.get(r, s) if r in reached else st.base_location for r, s in alive.items()}
         unreachable = _unreachable(st.knowledge.topology, st.base_location, pos)
-        self._returning = sorted(unreachable)
-        return {r: st.base_location if r in unreachable else s for r, s in pos.items()}
+        return {r: st.base_location if r in unreachable else s for r, s in pos.items()}, sorted(unreachable)
 
     def _cycle(self, net, positions: dict[str, str], owed: set[str], opts: SolverOptions) -> CyclePlan:
         """Pre-exploration, exploration and post-exploration; robots whose earlier
@@ -506,7 +504,7 @@ class CommunicationAction(CopsSkill):
             waiting = [c for c in comms if not self._done(c, st)]
             if waiting:
                 for c in waiting:
-                    other = c.receiver if c.sender == self.ctx.name else c.sender
+                    other = self._partner(c)
                     if other in kn.lost:
                         continue
                     silent_s = now - max(self._since, kn.heard.get(other, -math.inf))
@@ -523,6 +521,9 @@ class CommunicationAction(CopsSkill):
             self._since = now
         return Status.SUCCESS
 
+    def _partner(self, c: Communication) -> str:
+        return c.receiver if c.sender == self.ctx.name else c.sender
+
     def _allow(self, other: str) -> float:
         """Extra silence allowed for a partner that explores out of radio reach (its
         exploration time and the way back) or comes back by the standing order."""
@@ -535,8 +536,7 @@ class CommunicationAction(CopsSkill):
     def _done(self, c: Communication, st: CopsState) -> bool:
         kn = st.knowledge
         mid = message_id(st.cycle, st.part, c)
-        other = c.receiver if c.sender == self.ctx.name else c.sender
-        return other in kn.lost or (mid in kn.acked if c.sender == self.ctx.name else mid in kn.received)
+        return self._partner(c) in kn.lost or (mid in kn.acked if c.sender == self.ctx.name else mid in kn.received)
 
     def _send(self, c: Communication, st: CopsState, now: float) -> None:
         mid = message_id(st.cycle, st.part, c)
@@ -611,32 +611,38 @@ class TransitionAction(CopsSkill):
             self.stop_own_motion()
 
 
-class ActionTimer(CopsSkill):
+class _PlanTimer(CopsSkill):
+    """A sim-clock timer whose duration the plan sets when it is entered."""
+
+    ABSTRACT = True
+
+    def duration_s(self, st: CopsState) -> float:
+        raise NotImplementedError
+
+    def initialise(self) -> None:
+        self._until = self.ctx.clock.now_s + self.duration_s(self.state)
+
+    def update(self) -> Status:
+        return Status.SUCCESS if self.ctx.clock.now_s >= self._until - 1e-9 else Status.RUNNING
+
+
+class ActionTimer(_PlanTimer):
     """Action Timer: RUNNING for ΔT (from the plan) when the step has a transition
     to make, so that robots stay in step; SUCCESS at once at the last step of a part.
     Reads ``cops``."""
 
-    def initialise(self) -> None:
-        st = self.state
+    def duration_s(self, st: CopsState) -> float:
         plan = st.part_plan()
-        last = plan is None or st.step >= plan.horizon
-        self._until = self.ctx.clock.now_s + (0.0 if last else st.delta_t_s)
-
-    def update(self) -> Status:
-        return Status.SUCCESS if self.ctx.clock.now_s >= self._until - 1e-9 else Status.RUNNING
+        return 0.0 if plan is None or st.step >= plan.horizon else st.delta_t_s
 
 
-class ExplorationTimer(CopsSkill):
+class ExplorationTimer(_PlanTimer):
     """Exploration Timer: RUNNING for the robot's exploration time (its task's steps
     times ΔT), then SUCCESS. Reads ``cops``."""
 
-    def initialise(self) -> None:
-        st = self.state
+    def duration_s(self, st: CopsState) -> float:
         task = st.plan.exploration.get(self.ctx.name) if st.plan else None
-        self._until = self.ctx.clock.now_s + (task.steps * st.delta_t_s if task else 0.0)
-
-    def update(self) -> Status:
-        return Status.SUCCESS if self.ctx.clock.now_s >= self._until - 1e-9 else Status.RUNNING
+        return task.steps * st.delta_t_s if task else 0.0
 
 
 def _bearing(a: Any, b: Any) -> float:
