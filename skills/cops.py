@@ -225,7 +225,8 @@ class SolveCOPS(CopsSkill):
     plans pre-exploration, exploration and post-exploration (``plan_cycle``). Robots
     whose earlier information never reached the base are added to the
     post-exploration sources. With no frontier left, the plan is the recall: m
-    reaches every robot and brings it to the base. Every plan is checked with the
+    reaches every robot and brings it to the base, where those sources hand over
+    what the base lacks. Every plan is checked with the
     plan validator before it is used.
 
     Reads services ``team`` (robot -> start location) and ``base_location``.
@@ -262,10 +263,8 @@ class SolveCOPS(CopsSkill):
             owed = {r for r in positions if st.explored_in.get(r, -1) > kn.freshness.get(r, -1)}
             if frontiers:
                 cyc = self._cycle(net, positions, owed, opts)
-            elif owed:
-                cyc = self._collect(net, positions, owed, opts)
             else:
-                cyc = self._recall(net, positions, opts)
+                cyc = self._recall(net, positions, owed, opts)
             if frontiers and not cyc.exploration and not owed:
                 raise PlanningError(f"{len(frontiers)} frontiers left but no robot that m can reach is "
                                     f"sent to one (robots out of radio reach of the base and of each other)")
@@ -332,19 +331,19 @@ class SolveCOPS(CopsSkill):
             cyc = CyclePlan(cyc.pre, post, cyc.exploration, {**cyc.meta, "owed": sorted(owed)})
         return cyc
 
-    def _collect(self, net, positions: dict[str, str], owed: set[str], opts: SolverOptions) -> CyclePlan:
-        """No frontier left but information owed: a cycle of post-exploration only."""
+    def _recall(self, net, positions: dict[str, str], owed: set[str], opts: SolverOptions) -> CyclePlan:
+        """No frontier left: the recall brings home every robot m reaches, then the
+        robots whose information the base lacks (``owed``) hand it over there. The
+        information may hold new frontiers, so that recall is not the last plan."""
         me = self.ctx.name
-        pre = idle_plan(positions, {me}, "pre")
-        post = solve_post_exploration(net, sources=sorted(owed), positions=positions, masters=[me], static={me},
-                                      options=opts)
-        return CyclePlan(pre, post, {}, {"solve_time_s": post.meta.get("solve_time_s"), "owed": sorted(owed)})
-
-    def _recall(self, net, positions: dict[str, str], opts: SolverOptions) -> CyclePlan:
-        pre = solve_recall(net, positions=positions, masters={self.ctx.name}, static={self.ctx.name}, options=opts)
-        post = idle_plan(pre.final_positions(), pre.master_receivers(), "post")
-        return CyclePlan(pre, post, {}, {"solve_time_s": pre.meta.get("solve_time_s"), "recall": True,
-                                         "stranded": pre.meta["stranded"]})
+        pre = solve_recall(net, positions=positions, masters={me}, static={me}, options=opts)
+        home, holders = pre.final_positions(), pre.master_receivers()
+        sources = sorted(owed & holders)
+        post = solve_post_exploration(net, sources=sources, positions=home, masters=sorted(holders), static={me},
+                                      options=opts) if sources else idle_plan(home, holders, "post")
+        solve_s = sum(p.meta.get("solve_time_s") or 0.0 for p in (pre, post))
+        return CyclePlan(pre, post, {}, {"solve_time_s": round(solve_s, 4), "recall": True,
+                                         "stranded": pre.meta["stranded"], "owed": sorted(owed)})
 
 
 def _unreachable(topology: Topology, base: str, positions: dict[str, str]) -> set[str]:
@@ -470,7 +469,8 @@ class CommunicationAction(CopsSkill):
     """Communication Action of step t: PreIntCom, then ExtCom, then PostIntCom.
 
     In each phase the agent re-sends its outgoing messages every ``resend_period_s``
-    until each is acknowledged, and waits until every incoming one has arrived
+    until each is acknowledged (information it relays only once that has arrived),
+    and waits until every incoming one has arrived
     (``InformationStorage`` listens and acknowledges throughout). While it waits it
     greets every partner of the step so that they know it is alive. A partner not
     heard for ``lost_timeout_s`` (from the plan) is declared lost: its messages are
@@ -511,7 +511,7 @@ class CommunicationAction(CopsSkill):
                     if silent_s > st.lost_timeout_s + self._allow(other):
                         kn.declared[other] = now
                         self.event("robot_declared_lost", robot=other, cycle=st.cycle, part=st.part, step=st.step)
-                    elif c.sender == self.ctx.name:
+                    elif c.sender == self.ctx.name and not self._relay_pending(c, comms, st):
                         self._send(c, st, now)
                 self.feedback_message = f"t={st.step} {name}: {len(waiting)} to go"
                 if any(not self._done(c, st) for c in waiting):
@@ -520,6 +520,11 @@ class CommunicationAction(CopsSkill):
             self._i += 1
             self._since = now
         return Status.SUCCESS
+
+    def _relay_pending(self, c: Communication, comms: list[Communication], st: CopsState) -> bool:
+        """Whether information c.info that this agent relays in c has yet to arrive in
+        this phase (a relay chain within one step: send only what you hold)."""
+        return any(d.receiver == self.ctx.name and d.info == c.info and not self._done(d, st) for d in comms)
 
     def _partner(self, c: Communication) -> str:
         return c.receiver if c.sender == self.ctx.name else c.sender
@@ -562,8 +567,10 @@ class CommunicationAction(CopsSkill):
 class TransitionAction(CopsSkill):
     """Transition Action: move to the plan's next location s_{t+1} and set t = t + 1.
 
-    At the last step of a part it moves on: pre-exploration to exploration (a robot
-    the plan sends exploring) or to post-exploration, post-exploration to done.
+    At the last step of a part it moves on, once at the part's last location:
+    pre-exploration to exploration (a robot the plan sends exploring) or to
+    post-exploration, post-exploration to done. A robot that adopted the plan away
+    from where the plan has it (coming home by the standing order) goes there first.
 
     Reads/writes ``cops``; drives the robot through its NetworkView's routes.
     Returns RUNNING while moving, SUCCESS on arrival (at once for a stay), FAILURE
@@ -578,26 +585,34 @@ class TransitionAction(CopsSkill):
         plan = st.part_plan()
         if plan is None:
             return Status.FAILURE
-        if st.step >= plan.horizon:
+        last = st.step >= plan.horizon
+        moving = self._go(plan.location(self.ctx.name, min(st.step + 1, plan.horizon)))
+        if moving is not None:
+            return moving
+        if last:
             self._next_part(st)
-            return Status.SUCCESS
-        here, there = plan.location(self.ctx.name, st.step), plan.location(self.ctx.name, st.step + 1)
-        if here != there and self.ctx.robot is not None:
-            view = network_view(self.ctx)
-            if view.location() != there:
-                if self._target != there:
-                    route = view.route(there)
-                    if route is None:
-                        self.feedback_message = f"no route to {there}"
-                        return Status.FAILURE
-                    self.follow(route)
-                    self._target = there
-                if self.robot.path_status == "blocked":
-                    self.feedback_message = f"blocked on the way to {there}"
-                    return Status.FAILURE
-                return Status.RUNNING
-        st.step += 1
+        else:
+            st.step += 1
         return Status.SUCCESS
+
+    def _go(self, there: str) -> Status | None:
+        """Drive to ``there``: None once there, else RUNNING (FAILURE when it cannot)."""
+        if self.ctx.robot is None:
+            return None
+        view = network_view(self.ctx)
+        if view.location() == there:
+            return None
+        if self._target != there:
+            route = view.route(there)
+            if route is None:
+                self.feedback_message = f"no route to {there}"
+                return Status.FAILURE
+            self.follow(route)
+            self._target = there
+        if self.robot.path_status == "blocked":
+            self.feedback_message = f"blocked on the way to {there}"
+            return Status.FAILURE
+        return Status.RUNNING
 
     def _next_part(self, st: CopsState) -> None:
         if st.part == "pre":

@@ -282,7 +282,7 @@ def greedy_pre_plan(network: MCNetwork, positions: Mapping[str, str], masters: I
         (arrival, r), path = best
         g.deliver_m(r, g.pos[s], arrival, path)
     slots = {s: list(m) for s, m in sorted(rewards.items()) if m and s in network}
-    busy: set[str] = set()
+    busy: dict[str, str] = {}  # robot -> the rewarded place it holds
     gated = sorted({g.pos[r] for r in g.mobile if r in rew and r not in g.free})
     while True:
         best = None  # (key, robot, frontier, courier plan)
@@ -306,13 +306,18 @@ def greedy_pre_plan(network: MCNetwork, positions: Mapping[str, str], masters: I
             if not waiting:
                 continue
             couriers = []
-            for c in sorted(g.free):
-                if c in busy:
-                    continue
-                got = g.into_range(c, u)
-                if got is not None:
-                    cost = sum(network.mobility_cost(a, b) for a, b in zip(got[1], got[1][1:]))
-                    couriers.append((got[0], cost, c, got[1]))
+            # an idle robot brings m; failing that, one that holds a rewarded place
+            # goes out and comes back (a recall fetches the far robots so)
+            for pool in (sorted(r for r in g.free if r not in busy), sorted(busy)):
+                for c in pool:
+                    got = g.into_range(c, u)
+                    if got is not None:
+                        cost = sum(network.mobility_cost(a, b) for a, b in zip(got[1], got[1][1:]))
+                        if c in busy:
+                            cost += g.routes.cost(got[1][-1], busy[c])
+                        couriers.append((got[0], cost, c, got[1]))
+                if couriers:
+                    break
             if not couriers:
                 continue
             arrival, c_cost, c, path = min(couriers, key=lambda e: (e[0], e[1], e[2]))
@@ -328,9 +333,11 @@ def greedy_pre_plan(network: MCNetwork, positions: Mapping[str, str], masters: I
         if courier is not None:
             c, u, arrival, path = courier
             g.deliver_m(c, u, arrival, path)
+            if c in busy:
+                g.walk(c, g.routes.path(path[-1], busy[c]), g.free[c][0])
         t0, at = g.free[r]
         g.walk(r, g.routes.path(at, s), t0)
-        busy.add(r)
+        busy[r] = s
         slots[s].pop(0)
         # robots that m reached on the way become free too
         T = g.horizon()

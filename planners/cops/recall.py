@@ -4,7 +4,10 @@ Every robot that m can reach (robots move only once they hold m, so m travels ov
 communication edges and with robots that already hold it) is brought to the base.
 It is a reward problem like Problem 1: each robot holding m at the base at T earns
 ``home_reward``, minus the plan's cost C(Π). The horizon grows from the farthest
-robot's distance until every robot gets home or two longer horizons bring no more.
+robot's distance until every robot gets home or two longer horizons bring no more;
+the greedy plan of Problem 1 with the base as the only rewarded place (couriers
+bring m, robots walk home) warm-starts each solve, so a solve stopped by its time
+limit is never worse than that.
 """
 from __future__ import annotations
 
@@ -13,6 +16,7 @@ from typing import Iterable, Mapping
 from .ilp import ConnectivityProblem, InfeasibleProblem, SolverOptions, SolverTimeout, solve_connectivity
 from .network import MCNetwork
 from .plan import MASTER, Communication, Plan, idle_plan
+from .problems import _horizon_of, greedy_pre_plan
 
 #: Reward for each robot brought home; larger than any route's mobility cost.
 DEFAULT_HOME_REWARD = 1000.0
@@ -41,12 +45,15 @@ def solve_recall(network: MCNetwork, *, positions: Mapping[str, str], masters: I
             raise InfeasibleProblem(f"no route to the base for robot {r}")
     upper = max_horizon if max_horizon is not None else 2 * max(hops[positions[r]] for r in away) + 2
     opts = options or SolverOptions()
+    rewards = {base: (home_reward,) * len(mobile)}
+    greedy = greedy_pre_plan(network, positions, ms, st, mobile, rewards)
+    T_greedy = _horizon_of(greedy)
 
     def solve(T: int) -> Plan | None:
+        warm = greedy if T_greedy is not None and T_greedy <= T else None
         problem = ConnectivityProblem(network=network, horizon=T, positions=dict(positions), masters=ms, static=st,
-                                      explorers=set(mobile), reward_robots=set(mobile),
-                                      location_rewards={base: (home_reward,) * len(mobile)}, phase="recall",
-                                      options=opts)
+                                      explorers=set(mobile), reward_robots=set(mobile), location_rewards=rewards,
+                                      phase="recall", options=opts, warm_start=warm)
         try:
             return solve_connectivity(problem)
         except SolverTimeout:
@@ -56,6 +63,8 @@ def solve_recall(network: MCNetwork, *, positions: Mapping[str, str], masters: I
         return -1 if plan is None else sum(1 for r in mobile if plan.location(r, plan.horizon) == base)
 
     lower = max(hops[positions[r]] for r in away)
+    if T_greedy is not None and lower < T_greedy <= upper:  # start where the greedy plan ends
+        lower = T_greedy
     best, stalled = None, 0  # grow the horizon until everyone is home or it stops helping
     for T in range(lower, upper + 1, 2):
         plan = solve(T)

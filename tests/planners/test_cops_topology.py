@@ -2,6 +2,7 @@
 import pytest
 
 from delve.planners.cops import validate_plan
+from delve.planners.cops.problems import greedy_pre_plan
 from delve.planners.cops.recall import solve_recall
 from delve.planners.cops.topology import Topology, team_network
 
@@ -67,3 +68,13 @@ def test_recall_hands_m_to_robots_already_home():
     net = team_network(chain(3, 3), "s0", "base", {"r1": "s0"})
     plan = solve_recall(net, positions=net.positions(), masters={"base"}, static={"base"})
     assert plan.horizon == 0 and "r1" in plan.master_receivers() and not validate_plan(net, plan)
+
+
+def test_recall_fetches_a_robot_out_of_reach_with_one_already_home():
+    """The only robot holding m is home already: it walks out with m and back again."""
+    net = team_network(chain(9, 9), "s0", "base", {"r1": "s0", "r2": "s8"})
+    greedy = greedy_pre_plan(net, net.positions(), {"base"}, {"base"}, ["r1", "r2"], {"s0": (1000.0, 1000.0)})
+    assert greedy["r1"][0] == greedy["r1"][-1] == "s0" and "s7" in greedy["r1"]
+    assert greedy["r2"][-1] == "s0"
+    plan = solve_recall(net, positions=net.positions(), masters={"base"}, static={"base"})
+    assert plan.meta["stranded"] == [] and not validate_plan(net, plan)
