@@ -20,7 +20,6 @@ import statistics
 import sys
 import time
 from dataclasses import replace
-from pathlib import Path
 
 from delve import SCENARIOS_DIR
 from delve.executive.graph_mission import GraphMission

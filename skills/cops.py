@@ -28,7 +28,6 @@ import math
 from dataclasses import dataclass, field
 from typing import Any
 
-import numpy as np
 from py_trees.common import Status
 
 from ..planners.cops import (MASTER, Communication, CyclePlan, PlanningError, SolverOptions, plan_cycle,
