@@ -91,11 +91,18 @@ class CopsState:
     recall_after_s: float = 1800.0
     base_location: str | None = None
     explored_in: dict[str, int] = field(default_factory=dict)
+    planned_s: float = 0.0
 
     def part_plan(self) -> Plan | None:
         if self.plan is None:
             return None
         return {"pre": self.plan.pre, "post": self.plan.post}.get(self.part)
+
+    def plan_message(self) -> dict[str, Any]:
+        """The cycle plan m as a message carries it."""
+        return {"cycle": self.plan.to_dict(), "final": self.final, "delta_t_s": self.delta_t_s,
+                "lost_timeout_s": self.lost_timeout_s, "recall_after_s": self.recall_after_s,
+                "base_location": self.base_location}
 
     def adopt(self, msg: dict[str, Any]) -> None:
         """Take the cycle plan m of ``msg`` and continue from the step it arrived at."""
@@ -154,7 +161,8 @@ class InformationStorage(CopsSkill):
     Every tick it receives all ``cops`` messages: it acknowledges each info message
     (duplicates too), merges its payload into the agent's knowledge and, for a newer
     plan m, keeps it for ``WaitToReceivePlan``; it records acknowledgements and when
-    each sender was last heard. When the robot reaches a new location it merges
+    each sender was last heard. Once its final
+    plan is done, it answers a robot greeting it from the base with that plan. When the robot reaches a new location it merges
     what its own sensing revealed and marks its own information fresh.
 
     Reads/writes: ``cops`` (knowledge). Returns RUNNING.
@@ -180,7 +188,9 @@ class InformationStorage(CopsSkill):
                 continue
             d = msg.data
             kn.heard[msg.sender] = now
-            if d["type"] == "ack":
+            if d["type"] == "hello" and d.get("home") and st.final and st.part == "done":
+                self._hand_final_plan(msg.sender, st)
+            elif d["type"] == "ack":
                 kn.acked.add(d["id"])
             elif d["type"] == "info":
                 self.radio.send(msg.sender, KIND, {"type": "ack", "id": d["id"]})
@@ -193,6 +203,13 @@ class InformationStorage(CopsSkill):
                     kn.pending_plan = d
         self._sense(st)
         return Status.RUNNING
+
+    def _hand_final_plan(self, robot: str, st: CopsState) -> None:
+        """A robot back at the base that the final plan m never reached gets it there,
+        with its part done: the mission is over for it."""
+        payload = {**st.knowledge.payload(), "plan": st.plan_message()}
+        self.radio.send(robot, KIND, {"type": "info", "id": f"{st.cycle}:final:{robot}", "cycle": st.cycle,
+                                      "part": "done", "t": 0, "info": MASTER, "payload": payload})
 
     def _sense(self, st: CopsState) -> None:
         view = network_view(self.ctx)
@@ -285,6 +302,7 @@ class SolveCOPS(CopsSkill):
              "lost_timeout_s": self.p["lost_timeout_s"], "recall_after_s": self.p["recall_after_s"],
              "base_location": base_loc}
         st.adopt({"plan": m, "cycle": st.cycle, "part": "pre", "t": 0})
+        st.planned_s = self.ctx.clock.now_s
         st.knowledge.freshness[MASTER] = st.cycle
         self.event("cops_plan", cycle=st.cycle, final=final, robots=len(positions) - 1,
                    team=sorted(r for r in positions if r != self.ctx.name), locations=len(net),
@@ -417,7 +435,7 @@ class ReturnWithoutPlan(CopsSkill):
             if network_view(self.ctx).location() == st.base_location and now - self._greeted >= \
                     self.p["greet_period_s"]:
                 self._greeted = now
-                self.radio.send(self.p["leader"], KIND, {"type": "hello"})
+                self.radio.send(self.p["leader"], KIND, {"type": "hello", "home": True})
             return Status.RUNNING
         if now - self._since >= st.recall_after_s:
             view = network_view(self.ctx)
@@ -455,13 +473,60 @@ class FinishedPlan(_PartCheck):
 
 
 class MissionComplete(CopsSkill):
-    """SUCCESS when the agent has executed the final plan (the recall), else FAILURE."""
+    """SUCCESS when the agent has executed the final plan (the recall), else FAILURE.
+
+    A robot that has, back at the base, greets the leader (``home``) every
+    ``greet_period_s`` and is RUNNING until the leader answers with the final plan
+    (or ``lost_timeout_s`` passes) and a little longer, so that the leader learns it is
+    home. The leader (the agent with the ``team`` service) is RUNNING after its final
+    plan until every robot of the team has acknowledged the final plan it hands to
+    robots greeting it from the base: a robot the plan believed elsewhere, or wrongly
+    declared lost, comes home by the standing order and gets the plan there. A robot not heard within ``recall_after_s +
+    lost_timeout_s`` is declared lost (``robot_declared_lost``).
+    """
 
     TYPE_NAME = "MissionComplete?"
+    PARAMS = {**CopsSkill.PARAMS,
+              "greet_period_s": Param(float, 5.0, "a robot's greeting period once home", exclusive_minimum=0),
+              "leader": Param(str, "base", "the agent to greet (the planner at the base)")}
+
+    def initialise(self) -> None:
+        self._done_s: float | None = None
+        self._answered_s: float | None = None
+        self._greeted = -math.inf
 
     def update(self) -> Status:
         st = self.state
-        return Status.SUCCESS if st.final and st.part == "done" else Status.FAILURE
+        if not (st.final and st.part == "done"):
+            return Status.FAILURE
+        team = self.ctx.services.get("team")
+        now = self.ctx.clock.now_s
+        if team is None:
+            return self._home(st, now)
+        kn = st.knowledge
+        away = [r for r in sorted(team) if f"{st.cycle}:final:{r}" not in kn.acked]
+        if away and now - st.planned_s > st.recall_after_s + st.lost_timeout_s:
+            for r in away:
+                kn.declared[r] = now
+                self.event("robot_declared_lost", robot=r, cycle=st.cycle, part=st.part, step=st.step)
+            away = []
+        self.feedback_message = f"waiting for {', '.join(away)} at the base" if away else ""
+        return Status.RUNNING if away else Status.SUCCESS
+
+    def _home(self, st: CopsState, now: float) -> Status:
+        if self._done_s is None:
+            self._done_s = now
+        if f"{st.cycle}:final:{self.ctx.name}" in st.knowledge.received and self._answered_s is None:
+            self._answered_s = now
+        # after the answer, greet twice more: the leader's answer to each is acknowledged again
+        answered = self._answered_s is not None and now - self._answered_s >= 2 * self.p["greet_period_s"]
+        if answered or now - self._done_s >= st.lost_timeout_s:
+            return Status.SUCCESS
+        if now - self._greeted >= self.p["greet_period_s"]:
+            self._greeted = now
+            self.radio.send(self.p["leader"], KIND, {"type": "hello", "home": True})
+        self.feedback_message = f"home: telling {self.p['leader']}"
+        return Status.RUNNING
 
 
 class CommunicationAction(CopsSkill):
@@ -549,9 +614,7 @@ class CommunicationAction(CopsSkill):
         self._sent[mid] = now
         payload = st.knowledge.payload()
         if c.info == MASTER:
-            payload["plan"] = {"cycle": st.plan.to_dict(), "final": st.final, "delta_t_s": st.delta_t_s,
-                               "lost_timeout_s": st.lost_timeout_s, "recall_after_s": st.recall_after_s,
-                               "base_location": st.base_location}
+            payload["plan"] = st.plan_message()
         self.radio.send(c.receiver, KIND, {"type": "info", "id": mid, "cycle": st.cycle, "part": st.part,
                                            "t": c.t, "info": c.info, "payload": payload})
 

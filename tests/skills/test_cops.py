@@ -8,7 +8,8 @@ import pytest
 from delve.planners.cops.plan import Communication, CyclePlan, Plan
 from delve.planners.cops.topology import Topology
 from delve.skills.base import AgentContext
-from delve.skills.cops import CommunicationAction, InformationStorage, TransitionAction, message_id
+from delve.skills.cops import (CommunicationAction, InformationStorage, MissionComplete, TransitionAction,
+                               message_id)
 from py_trees.common import Status
 
 
@@ -151,3 +152,54 @@ def test_a_robot_away_from_the_plan_goes_to_its_place_before_the_part_ends():
     action.tick_once()
     assert action.status == Status.SUCCESS and robot.location() == "s0" and st.part == "post"
     py_trees.blackboard.Blackboard.clear()
+
+
+def final_state(agent: str, services: dict) -> tuple:
+    py_trees.blackboard.Blackboard.clear()
+    ctx = AgentContext(name=agent, namespace=f"/{agent}", clock=SimpleNamespace(now_s=100.0),
+                       log=lambda *a, **k: None, services=services)
+    storage, done = InformationStorage("Information storage", ctx), MissionComplete("Mission complete?", ctx)
+    home = Plan(horizon=0, trajectories={"base": ["s0"], "r1": ["s0"]}, masters=["base"], phase="recall")
+    st = storage.state
+    st.plan, st.cycle, st.part, st.final, st.planned_s = CyclePlan(home, home, {}), 6, "done", True, 50.0
+    return ctx, storage, done, st
+
+
+def test_the_leader_waits_for_every_robot_home_and_hands_it_the_final_plan():
+    radio = Radio()
+    ctx, storage, done, st = final_state("base", {"radio": radio, "team": {"r1": "s0"}})
+    done.tick_once()
+    assert done.status == Status.RUNNING  # r1 not heard since the final plan
+    radio.inbox.append(SimpleNamespace(sender="r1", kind="cops", data={"type": "hello", "home": True}))
+    storage.tick_once()
+    (reply,) = radio.infos()
+    assert reply["id"] == "6:final:r1" and reply["part"] == "done" and reply["payload"]["plan"]["final"]
+    done.tick_once()
+    assert done.status == Status.RUNNING  # until r1 acknowledges it
+    radio.inbox.append(SimpleNamespace(sender="r1", kind="cops", data={"type": "ack", "id": "6:final:r1"}))
+    storage.tick_once()
+    done.tick_once()
+    assert done.status == Status.SUCCESS
+
+
+def test_the_leader_declares_a_robot_never_heard_again_lost():
+    ctx, storage, done, st = final_state("base", {"radio": Radio(), "team": {"r1": "s0"}})
+    ctx.clock.now_s = 50.0 + st.recall_after_s + st.lost_timeout_s + 1.0
+    done.tick_once()
+    assert done.status == Status.SUCCESS and "r1" in st.knowledge.lost
+
+
+def test_a_robot_home_greets_the_leader_until_it_answers():
+    radio = Radio()
+    ctx, storage, done, st = final_state("r1", {"radio": radio})
+    done.tick_once()
+    assert done.status == Status.RUNNING and radio.sent == [("base", "cops", {"type": "hello", "home": True})]
+    radio.inbox.append(SimpleNamespace(sender="base", kind="cops", data={
+        "type": "info", "id": "6:final:r1", "cycle": 6, "part": "done", "t": 0, "info": "m",
+        "payload": {"topology": Topology().to_dict(), "freshness": {}, "declared": {}, "heard": {}}}))
+    storage.tick_once()
+    done.tick_once()
+    assert done.status == Status.RUNNING  # greets a little longer, for the leader to hear the ack
+    ctx.clock.now_s += 10.0
+    done.tick_once()
+    assert done.status == Status.SUCCESS
