@@ -161,9 +161,9 @@ class InformationStorage(CopsSkill):
     Every tick it receives all ``cops`` messages: it acknowledges each info message
     (duplicates too), merges its payload into the agent's knowledge and, for a newer
     plan m, keeps it for ``WaitToReceivePlan``; it records acknowledgements and when
-    each sender was last heard. Once its final
-    plan is done, it answers a robot greeting it from the base with that plan. When the robot reaches a new location it merges
-    what its own sensing revealed and marks its own information fresh.
+    each sender was last heard. Once it has made the final plan, it answers a robot
+    greeting it from the base with that plan. When the robot reaches a new location
+    it merges what its own sensing revealed and marks its own information fresh.
 
     Reads/writes: ``cops`` (knowledge). Returns RUNNING.
     """
@@ -188,7 +188,7 @@ class InformationStorage(CopsSkill):
                 continue
             d = msg.data
             kn.heard[msg.sender] = now
-            if d["type"] == "hello" and d.get("home") and st.final and st.part == "done":
+            if d["type"] == "hello" and d.get("home") and st.final:
                 self._hand_final_plan(msg.sender, st)
             elif d["type"] == "ack":
                 kn.acked.add(d["id"])
@@ -478,7 +478,7 @@ class MissionComplete(CopsSkill):
     A robot that has, back at the base, greets the leader (``home``) every
     ``greet_period_s`` and is RUNNING until the leader answers with the final plan
     (or ``lost_timeout_s`` passes) and a little longer, so that the leader learns it is
-    home. The leader (the agent with the ``team`` service) is RUNNING after its final
+    home. The leader (``leader``, it has the ``team`` service) is RUNNING after its final
     plan until every robot of the team has acknowledged the final plan it hands to
     robots greeting it from the base: a robot the plan believed elsewhere, or wrongly
     declared lost, comes home by the standing order and gets the plan there. A robot not heard within ``recall_after_s +
@@ -488,7 +488,7 @@ class MissionComplete(CopsSkill):
     TYPE_NAME = "MissionComplete?"
     PARAMS = {**CopsSkill.PARAMS,
               "greet_period_s": Param(float, 5.0, "a robot's greeting period once home", exclusive_minimum=0),
-              "leader": Param(str, "base", "the agent to greet (the planner at the base)")}
+              "leader": Param(str, "base", "the planner at the base (robots greet it)")}
 
     def initialise(self) -> None:
         self._done_s: float | None = None
@@ -499,10 +499,10 @@ class MissionComplete(CopsSkill):
         st = self.state
         if not (st.final and st.part == "done"):
             return Status.FAILURE
-        team = self.ctx.services.get("team")
         now = self.ctx.clock.now_s
-        if team is None:
+        if self.ctx.name != self.p["leader"]:
             return self._home(st, now)
+        team = self.ctx.services["team"]
         kn = st.knowledge
         away = [r for r in sorted(team) if f"{st.cycle}:final:{r}" not in kn.acked]
         if away and now - st.planned_s > st.recall_after_s + st.lost_timeout_s:
