@@ -19,29 +19,18 @@ validator.
 from __future__ import annotations
 
 import argparse
-import random
 import shlex
 import sys
 import time
 
-from delve.planners.cops import (PlanningError, Robot, SolverOptions, available_solver, plan_cycle,
-                                 tunnel_network_graph, validate_plan)
+from delve.planners.cops import (PlanningError, SolverOptions, available_solver, plan_cycle,
+                                 validate_plan)
 from delve.planners.cops.clustering import should_cluster
-from delve.planners.cops.network import dead_ends
-
-
-def scenario(n_locations: int, n_robots: int, seed: int):
-    net = tunnel_network_graph(n_locations, seed=seed)
-    rng = random.Random(seed)
-    others = [s for s in net.locations if s != "s0"]
-    for i in range(n_robots):
-        net.add_robot(Robot(f"r{i + 1}", "s0" if i < (n_robots + 1) // 2 else rng.choice(others)))
-    net.frontiers = set(dead_ends(net))
-    return net
+from delve.planners.cops.network import spread_team_network
 
 
 def run_cell(n: int, r: int, clustered: bool, opts: SolverOptions, seed: int):
-    net = scenario(n, r, seed)
+    net = spread_team_network(n, r, seed)
     t0 = time.perf_counter()
     try:
         cyc = plan_cycle(net, clustering=clustered, options=opts)
@@ -80,7 +69,7 @@ def main(argv=None) -> int:
             skip = False
             for r in args.robots:
                 label = "yes" if clustered else "no"
-                net = scenario(n, r, args.seed)
+                net = spread_team_network(n, r, args.seed)
                 auto = "yes" if should_cluster(net, net.positions(), {net.base_station}) else "no"
                 if skip:
                     print(f"{n:>9} {r:>6} {label:>10} {auto:>4} {'-':>8} {'-':>6} {'-':>6} {'-':>5} {'-':>6} "

@@ -21,6 +21,7 @@ from typing import Any, Callable
 import networkx as nx
 import numpy as np
 
+from .body import RobotBody
 from .platforms import Platform
 from .radio import Endpoint
 
@@ -127,7 +128,7 @@ class GraphWorld:
         return None if d <= self.at_location_m else f"not at a location (nearest is '{name}', {d:.1f} m away)"
 
 
-class GraphRobot:
+class GraphRobot(RobotBody):
     """A robot on a :class:`GraphWorld`: drives tunnel by tunnel, explores locations.
 
     ``follow_path`` takes waypoints that must be locations, each joined to the one
@@ -158,35 +159,7 @@ class GraphRobot:
         self._known = Known()
         self._arrive()
 
-    # ---- the robot interface (motion, radio) -------------------------------------
-    @property
-    def name(self) -> str:
-        return self._name
-
-    @property
-    def platform(self) -> str:
-        return self._platform.name
-
-    @property
-    def mobility(self) -> Platform:
-        return self._platform
-
-    @property
-    def position(self) -> np.ndarray:
-        return self._pos.copy()
-
-    @property
-    def home(self) -> np.ndarray:
-        return self._home.copy()
-
-    @property
-    def endurance_remaining_s(self) -> float:
-        return self._endurance
-
-    @property
-    def distance_m(self) -> float:
-        return self._distance
-
+    # ---- the robot interface (motion, radio; the rest in RobotBody) ---------------
     @property
     def traversed_path(self) -> np.ndarray:
         return np.array(self._trail + [self._pos])
@@ -194,14 +167,6 @@ class GraphRobot:
     @property
     def radio(self) -> "GraphRadioEndpoint":
         return self._radio
-
-    @property
-    def path_status(self) -> str:
-        return self._status
-
-    @property
-    def command_id(self) -> int:
-        return self._commands
 
     @property
     def remaining_path(self) -> np.ndarray:

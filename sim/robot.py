@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .body import RobotBody
 from .payload import PanTiltZoomCamera
 from .platforms import Platform
 from .radio import BREADCRUMB_ANTENNA_HEIGHT_M, BreadcrumbDrop
@@ -24,7 +25,7 @@ IDLE, FOLLOWING, ARRIVED, BLOCKED = "idle", "following", "arrived", "blocked"
 _GOLDEN = (math.sqrt(5) - 1) / 2
 
 
-class SimRobot:
+class SimRobot(RobotBody):
     """A legged or aerial robot in a :class:`World`.
 
     Legged robots keep their body ``body_height_m`` above the ground, refuse steps
@@ -78,23 +79,7 @@ class SimRobot:
 
         self._sensors = [(spec, spec.beam_directions(0.0)) for spec in (platform.lidar, platform.terrain) if spec]
 
-    # ---- the robot interface -------------------------------------------------
-    @property
-    def name(self) -> str:
-        return self._name
-
-    @property
-    def platform(self) -> str:
-        return self._platform.name
-
-    @property
-    def mobility(self) -> Platform:
-        return self._platform
-
-    @property
-    def position(self) -> np.ndarray:
-        return self._pos.copy()
-
+    # ---- the robot interface (the rest in RobotBody) ----------------------------
     @property
     def yaw_rad(self) -> float:
         return self._yaw
@@ -105,21 +90,8 @@ class SimRobot:
         return lidar.pitch_deg + lidar.vertical_fov_deg / 2
 
     @property
-    def home(self) -> np.ndarray:
-
-        return self._home.copy()
-
-    @property
     def onboard_map(self) -> VoxelMap:
         return self._map
-
-    @property
-    def endurance_remaining_s(self) -> float:
-        return self._endurance
-
-    @property
-    def distance_m(self) -> float:
-        return self._distance
 
     @property
     def traversed_path(self) -> np.ndarray:
@@ -128,10 +100,6 @@ class SimRobot:
     @property
     def radio(self) -> "RadioEndpoint":
         return self._radio
-
-    @property
-    def path_status(self) -> str:
-        return self._status
 
     @property
     def breadcrumbs(self) -> int:
@@ -201,11 +169,6 @@ class SimRobot:
         """Stop and power down: endurance no longer counts down (the mission is over)."""
         self.stop()
         self._parked = True
-
-    @property
-    def command_id(self) -> int:
-        """Counts motion commands (``follow_path`` and ``stop``)."""
-        return self._commands
 
     def follow_path(self, path: np.ndarray) -> None:
         self._commands += 1

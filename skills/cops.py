@@ -25,6 +25,7 @@ freshness, lost robots) and, for b = m, the cycle plan.
 from __future__ import annotations
 
 import math
+from abc import abstractmethod
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -119,6 +120,11 @@ def message_id(cycle: int, part: str, c: Communication) -> str:
     return f"{cycle}:{part}:{c.t}:{c.sender}>{c.receiver}:{c.info}"
 
 
+def final_plan_id(cycle: int, robot: str) -> str:
+    """Id of the final plan the leader hands to ``robot`` at the base."""
+    return f"{cycle}:final:{robot}"
+
+
 def network_view(ctx: AgentContext) -> Any:
     """The robot's NetworkView: a service, the robot itself, or its voxel map."""
     view = ctx.services.get("network_view")
@@ -208,7 +214,7 @@ class InformationStorage(CopsSkill):
         """A robot back at the base that the final plan m never reached gets it there,
         with its part done: the mission is over for it."""
         payload = {**st.knowledge.payload(), "plan": st.plan_message()}
-        self.radio.send(robot, KIND, {"type": "info", "id": f"{st.cycle}:final:{robot}", "cycle": st.cycle,
+        self.radio.send(robot, KIND, {"type": "info", "id": final_plan_id(st.cycle, robot), "cycle": st.cycle,
                                       "part": "done", "t": 0, "info": MASTER, "payload": payload})
 
     def _sense(self, st: CopsState) -> None:
@@ -298,11 +304,9 @@ class SolveCOPS(CopsSkill):
         st.cycle += 1
         for r in cyc.exploration:
             st.explored_in[r] = st.cycle
-        m = {"cycle": cyc.to_dict(), "final": final, "delta_t_s": self.p["delta_t_s"],
-             "lost_timeout_s": self.p["lost_timeout_s"], "recall_after_s": self.p["recall_after_s"],
-             "base_location": base_loc}
-        st.adopt({"plan": m, "cycle": st.cycle, "part": "pre", "t": 0})
-        st.planned_s = self.ctx.clock.now_s
+        st.plan, st.final, st.part, st.step = cyc, final, "pre", 0
+        st.delta_t_s, st.lost_timeout_s = self.p["delta_t_s"], self.p["lost_timeout_s"]
+        st.recall_after_s, st.planned_s = self.p["recall_after_s"], self.ctx.clock.now_s
         st.knowledge.freshness[MASTER] = st.cycle
         self.event("cops_plan", cycle=st.cycle, final=final, robots=len(positions) - 1,
                    team=sorted(r for r in positions if r != self.ctx.name), locations=len(net),
@@ -477,12 +481,13 @@ class MissionComplete(CopsSkill):
 
     A robot that has, back at the base, greets the leader (``home``) every
     ``greet_period_s`` and is RUNNING until the leader answers with the final plan
-    (or ``lost_timeout_s`` passes) and a little longer, so that the leader learns it is
-    home. The leader (``leader``, it has the ``team`` service) is RUNNING after its final
-    plan until every robot of the team has acknowledged the final plan it hands to
-    robots greeting it from the base: a robot the plan believed elsewhere, or wrongly
-    declared lost, comes home by the standing order and gets the plan there. A robot not heard within ``recall_after_s +
-    lost_timeout_s`` is declared lost (``robot_declared_lost``).
+    (or ``lost_timeout_s`` passes) and a little longer, so that the leader learns
+    it is home. The leader (``leader``, it has the ``team`` service) is RUNNING
+    after its final plan until every robot of the team has acknowledged the final
+    plan it hands to robots greeting it from the base: a robot the plan believed
+    elsewhere, or wrongly declared lost, comes home by the standing order and gets
+    the plan there. A robot silent for ``recall_after_s + lost_timeout_s`` after
+    the final plan is declared lost (``robot_declared_lost``).
     """
 
     TYPE_NAME = "MissionComplete?"
@@ -504,7 +509,7 @@ class MissionComplete(CopsSkill):
             return self._home(st, now)
         team = self.ctx.services["team"]
         kn = st.knowledge
-        away = [r for r in sorted(team) if f"{st.cycle}:final:{r}" not in kn.acked]
+        away = [r for r in sorted(team) if final_plan_id(st.cycle, r) not in kn.acked]
         if away and now - st.planned_s > st.recall_after_s + st.lost_timeout_s:
             for r in away:
                 kn.declared[r] = now
@@ -516,7 +521,7 @@ class MissionComplete(CopsSkill):
     def _home(self, st: CopsState, now: float) -> Status:
         if self._done_s is None:
             self._done_s = now
-        if f"{st.cycle}:final:{self.ctx.name}" in st.knowledge.received and self._answered_s is None:
+        if final_plan_id(st.cycle, self.ctx.name) in st.knowledge.received and self._answered_s is None:
             self._answered_s = now
         # after the answer, greet twice more: the leader's answer to each is acknowledged again
         answered = self._answered_s is not None and now - self._answered_s >= 2 * self.p["greet_period_s"]
@@ -693,8 +698,9 @@ class _PlanTimer(CopsSkill):
 
     ABSTRACT = True
 
+    @abstractmethod
     def duration_s(self, st: CopsState) -> float:
-        raise NotImplementedError
+        """The timer's duration, read from the plan when the timer is entered."""
 
     def initialise(self) -> None:
         self._until = self.ctx.clock.now_s + self.duration_s(self.state)

@@ -277,6 +277,16 @@ class _Model:
         if self.p.time_weight:
             self.time_terms.append((self.p.time_weight * (t + 1)) * var)
 
+    def carry_arcs(self, carry: dict, keep, U: float, inflow: dict, outflow: dict) -> None:
+        """Flow arcs of information carried by moving robots: one per move (t, u, v) that
+        ``keep(t, u, v)`` admits, bounded by the robots making it."""
+        for (t, u, v), cap in carry.items():
+            if keep(t, u, v):
+                f = self.var(0, U)
+                self.le([f], U * pulp.lpSum(cap))
+                outflow[u, t].append(f)
+                inflow[v, t + 1].append(f)
+
     def add(self, constraint) -> None:
         if isinstance(constraint, bool):
             if not constraint:
@@ -460,13 +470,7 @@ class _Model:
                         outflow[u, t].append(w[u, t])
                 if any((u, t) in w for t in range(T + 1)):
                     self.le([w[u, t] for t in range(T + 1) if (u, t) in w], 1)
-            for (t, u, v), cap in carry.items():
-                if not (m_possible(u, t) and m_useful(v, t + 1)):
-                    continue
-                f = self.var(0, U)
-                self.le([f], U * pulp.lpSum(cap))
-                outflow[u, t].append(f)
-                inflow[v, t + 1].append(f)
+            self.carry_arcs(carry, lambda t, u, v: m_possible(u, t) and m_useful(v, t + 1), U, inflow, outflow)
             for t in range(T + 1):
                 for u, v in comm_edges:
                     if not (m_possible(u, t) and v in occupiable[t] and m_useful(v, t)):
@@ -546,13 +550,7 @@ class _Model:
 
             inflow = defaultdict(list)
             outflow = defaultdict(list)
-            for (t, u, v), cap in carry.items():
-                if not (possible(u, t) and possible(v, t + 1)):
-                    continue
-                f = self.var(0, U)
-                self.le([f], U * pulp.lpSum(cap))
-                outflow[u, t].append(f)
-                inflow[v, t + 1].append(f)
+            self.carry_arcs(carry, lambda t, u, v: possible(u, t) and possible(v, t + 1), U, inflow, outflow)
             arcs = {}
             for t in range(T + 1):
                 for u, v in comm_edges:

@@ -13,6 +13,7 @@ constrained), the base station (a static robot) and the frontier locations.
 from __future__ import annotations
 
 import math
+import random
 from dataclasses import dataclass, replace
 from typing import Any, Iterable, Mapping
 
@@ -472,3 +473,16 @@ def dead_ends(network: MCNetwork) -> list[str]:
     """Locations with a single mobility neighbour, other than the base (tunnel ends)."""
     und = network.mobility.to_undirected(as_view=True)
     return [s for s in network.locations if s != network.base and und.degree(s) <= 1]
+
+
+def spread_team_network(n_locations: int, n_robots: int, seed: int = 0) -> MCNetwork:
+    """A :func:`tunnel_network_graph` with a team spread over it, the frontiers at its
+    dead ends: half the robots (rounded up) at the base, the rest at random locations
+    (seeded). The planner's benchmark and tests use it."""
+    net = tunnel_network_graph(n_locations, seed=seed)
+    rng = random.Random(seed)
+    others = [s for s in net.locations if s != net.base]
+    for i in range(n_robots):
+        net.add_robot(Robot(f"r{i + 1}", net.base if i < (n_robots + 1) // 2 else rng.choice(others)))
+    net.frontiers = set(dead_ends(net))
+    return net

@@ -1,8 +1,7 @@
-import random
 
-from delve.planners.cops import Robot, SolverOptions, network_from_dict, tunnel_network_graph, validate_plan
+from delve.planners.cops import SolverOptions, network_from_dict, validate_plan
 from delve.planners.cops.clustering import build_clusters, idle_locations, plan_cycle_clustered
-from delve.planners.cops.network import dead_ends
+from delve.planners.cops.network import spread_team_network
 
 
 def test_idle_locations_are_pruned_recursively():
@@ -16,18 +15,8 @@ def test_idle_locations_are_pruned_recursively():
     assert idle == {"s2", "s3"}
 
 
-def spread_team(n_locations, n_robots, seed):
-    net = tunnel_network_graph(n_locations, seed=seed)
-    rng = random.Random(seed)
-    others = [s for s in net.locations if s != "s0"]
-    for i in range(n_robots):
-        net.add_robot(Robot(f"r{i + 1}", "s0" if i < (n_robots + 1) // 2 else rng.choice(others)))
-    net.frontiers = set(dead_ends(net))
-    return net
-
-
 def test_clusters_form_a_tree_that_covers_the_active_network():
-    net = spread_team(60, 6, seed=2)
+    net = spread_team_network(60, 6, seed=2)
     cs = build_clusters(net, net.positions(), net.frontiers, "s0", net.static_robots(),
                         max_cluster_locations=12)
     assert len(cs.clusters) >= 2
@@ -43,7 +32,7 @@ def test_clusters_form_a_tree_that_covers_the_active_network():
 
 
 def test_clustered_cycle_returns_valid_plans_on_a_bigger_network():
-    net = spread_team(40, 4, seed=3)
+    net = spread_team_network(40, 4, seed=3)
     opts = SolverOptions(time_limit_s=3, probe_time_limit_s=1, mip_gap=0.05)
     cyc = plan_cycle_clustered(net, max_cluster_locations=12, options=opts)
     assert cyc.meta["clusters"] >= 2

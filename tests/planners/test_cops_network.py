@@ -72,3 +72,11 @@ def test_tunnel_network_is_a_connected_tree_of_50m_steps_with_line_of_sight_radi
     assert max(depth.values()) <= 1000.0 + 1e-6
     assert len(dead_ends(net)) >= 2  # it forks
     assert tunnel_network_graph(60, seed=3).to_dict() == net.to_dict()  # deterministic
+
+
+def test_spread_team_network_puts_half_the_team_at_the_base():
+    from delve.planners.cops.network import dead_ends, spread_team_network
+    net = spread_team_network(40, 5, seed=3)
+    pos = net.positions()
+    assert sum(1 for r in pos if r.startswith("r") and pos[r] == net.base) >= 3
+    assert net.frontiers == set(dead_ends(net)) and spread_team_network(40, 5, seed=3).positions() == pos

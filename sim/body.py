@@ -1,0 +1,62 @@
+"""What every simulated robot shows of itself, whatever world it drives in."""
+from __future__ import annotations
+
+import numpy as np
+
+from .platforms import Platform
+from .radio import Endpoint
+
+
+class RobotBody:
+    """The read-only part of the robot interface that voxel and graph robots share.
+
+    Subclasses set ``_name``, ``_platform``, ``_pos``, ``_home``, ``_endurance``,
+    ``_distance``, ``_radio``, ``_status`` and ``_commands``.
+    """
+
+    _name: str
+    _platform: Platform
+    _pos: np.ndarray
+    _home: np.ndarray
+    _endurance: float
+    _distance: float
+    _radio: Endpoint
+    _status: str
+    _commands: int
+
+    @property
+    def name(self) -> str:
+        return self._name
+
+    @property
+    def platform(self) -> str:
+        return self._platform.name
+
+    @property
+    def mobility(self) -> Platform:
+        return self._platform
+
+    @property
+    def position(self) -> np.ndarray:
+        return self._pos.copy()
+
+    @property
+    def home(self) -> np.ndarray:
+        return self._home.copy()
+
+    @property
+    def endurance_remaining_s(self) -> float:
+        return self._endurance
+
+    @property
+    def distance_m(self) -> float:
+        return self._distance
+
+    @property
+    def path_status(self) -> str:
+        return self._status
+
+    @property
+    def command_id(self) -> int:
+        """Counts motion commands (``follow_path`` and ``stop``)."""
+        return self._commands
