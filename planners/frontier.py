@@ -45,7 +45,11 @@ class FrontierGoal:
     offset_m: float
 
 
-def frontier_voxels(grid: Grid, among: np.ndarray | None = None, depth: int = 3) -> np.ndarray:
+#: Unknown voxels in a row beyond a free voxel that make it a frontier.
+FRONTIER_DEPTH = 3
+
+
+def frontier_voxels(grid: Grid, among: np.ndarray | None = None, depth: int = FRONTIER_DEPTH) -> np.ndarray:
     """Flat indices of FREE voxels that border unknown space: all of them, or those of
     ``among`` (flat indices) that still do.
 

@@ -2,13 +2,18 @@
 
 :func:`extract_topology` turns an occupancy grid into a :class:`Topology`:
 
-* Locations S are the cells of a FIXED world lattice of edge ``cell_m``: lattice
-  index ``floor(world / cell_m)`` (of a voxel's centre), name ``c{i}_{j}_{k}``
-  (indices may be negative: ``c-1_3_0``). Any robot names a place the same way,
-  whatever its map's origin. A cell is a location when its largest connected piece
-  of *standable* known-free voxels (its *main component*) holds at least
-  ``min_free_voxels`` voxels.
-* A location's position is the voxel of its main component whose centre is
+* Locations S are the cells of a FIXED world lattice of edge ``cell_m`` whose cell
+  (0, 0, 0) has its lower corner at ``lattice_origin``: lattice index
+  ``floor((world - lattice_origin) / cell_m)`` (of a voxel's centre), name
+  ``c{i}_{j}_{k}`` (indices may be negative: ``c-1_3_0``). Robots that share the
+  lattice origin name a place the same way, whatever their maps' origins. (Put a
+  cell's centre where the team starts, so that the first tunnel is not cut along
+  its centre line.) Components are the connected pieces, within one cell, of the
+  *passable* known-free voxels (by default the *standable* ones; a caller may pass
+  all known free space, since a LiDAR sees a floor in rings that the free space
+  above joins). A cell is a location when its *main component*, the one with the
+  most standable voxels, holds at least ``min_free_voxels`` of them.
+* A location's position is the standable voxel of its main component whose centre is
   nearest the cell's centre (ties broken by the voxel's world position). Two robots
   whose maps differ (or whose voxels are not aligned) may pick slightly different
   voxels; the name, not the position, identifies a location.
@@ -25,6 +30,8 @@
   clipping the corner of a cell, a second passage through a cell) are not lost:
   the locations that one connected fragment of them touches are joined pairwise.
   An edge's length is the distance between the positions.
+* The dense steps run on the box of the known-free voxels only (plus a margin for
+  the frontier test), so their cost follows the mapped part of the world.
 * A communication edge (~>) joins two locations whose *sight points* (positions
   raised by ``sight_height_m``) are within ``comm_range_m`` and see each other: the
   straight segment, sampled every half voxel, crosses only known-free voxels.
@@ -40,7 +47,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
-from ..frontier import frontier_voxels
+from ..frontier import FRONTIER_DEPTH, frontier_voxels
 from ..occupancy import FREE, Grid
 from .topology import Topology
 
@@ -77,36 +84,47 @@ def extract_topology(
     min_free_voxels: int = DEFAULT_MIN_FREE_VOXELS,
     sight_height_m: float = 0.0,
     visited: np.ndarray | None = None,
+    lattice_origin: np.ndarray | None = None,
+    passable: np.ndarray | None = None,
 ) -> Topology:
     """The topology (locations, explored ones, mobility and communication edges) of a map.
 
     ``occupancy`` is an int8 (nx, ny, nz) grid of UNKNOWN / FREE / OCCUPIED,
     ``origin`` the world position of voxel (0, 0, 0)'s lower corner. ``standable``
     is a bool mask of the voxels a robot can stand on or fly through (None: every
-    known-free voxel); ``free`` the flat indices of the FREE voxels when the map
+    known-free voxel); ``passable`` a bool mask of the voxels a robot may pass
+    through (None: the standable ones), whose connectivity makes the components and
+    the mobility edges, while only standable voxels count towards
+    ``min_free_voxels`` and become positions; ``free`` the flat indices of the FREE voxels when the map
     keeps them (the frontier search then needs no scan of the grid); ``visited``
-    (N, 3) world points where robots have been. Raises ``ValueError`` for bad inputs.
+    (N, 3) world points where robots have been; ``lattice_origin`` the lattice's
+    corner (default: the world's origin). Raises ``ValueError`` for bad inputs.
     """
     grid = _checked_grid(occupancy, origin, voxel_size_m, free)
     _check_parameters(cell_m, comm_range_m, min_free_voxels, sight_height_m)
-    visited_cells = _visited_cells(visited, cell_m)
+    corner = _checked_point(lattice_origin, "lattice_origin")
+    visited_cells = _visited_cells(visited, cell_m, corner)
     mask = _standable_mask(grid, standable)
-    partition = _partition(grid, cell_m)
-    labels = _components_within_cells(mask, partition)
+    passable_mask = mask if passable is None else _standable_mask(grid, passable, "passable")
+    grid, (mask, passable_mask) = _cropped(grid, [mask, passable_mask])
+    partition = _partition(grid, cell_m, corner)
+    labels = _components_within_cells(mask | passable_mask, partition)
     topo = Topology()
     flat = np.flatnonzero(labels)
     if len(flat) == 0:
         return topo
     ijk = np.stack(np.unravel_index(flat, grid.shape), axis=1)
     component = labels.reshape(-1)[flat].astype(np.int64) - 1
+    stands = mask.reshape(-1)[flat]
     cell_key = _pack(np.stack([partition[a][ijk[:, a]] for a in range(3)], axis=1), partition)
-    location_of, location_keys = _locations(component, cell_key, min_free_voxels)
+    location_of, location_keys = _locations(component, cell_key, stands, min_free_voxels)
     if len(location_keys) == 0:
         return topo
     lattice = _unpack(location_keys, partition)
     names = [cell_name(c) for c in lattice]
-    members = location_of[component] >= 0
-    positions = _positions(grid.to_world(ijk[members]), location_of[component[members]], lattice, cell_m)
+    members = (location_of[component] >= 0) & stands
+    positions = _positions(grid.to_world(ijk[members]), location_of[component[members]],
+                           corner + (lattice + 0.5) * cell_m)
     explored = ~np.isin(location_keys, _frontier_cell_keys(grid, partition))
     explored |= [tuple(c) in visited_cells for c in lattice.tolist()]
     for name, pos, done in zip(names, positions, explored):
@@ -122,9 +140,11 @@ def extract_topology(
 
 
 # -- the lattice ------------------------------------------------------------------------
-def lattice_cells(points: np.ndarray, cell_m: float = DEFAULT_CELL_M) -> np.ndarray:
-    """(N, 3) int64 lattice indices of world points (N, 3): ``floor(p / cell_m)``."""
-    return np.floor(np.asarray(points, float).reshape(-1, 3) / cell_m).astype(np.int64)
+def lattice_cells(points: np.ndarray, cell_m: float = DEFAULT_CELL_M,
+                  lattice_origin: np.ndarray | None = None) -> np.ndarray:
+    """(N, 3) int64 lattice indices of world points (N, 3): ``floor((p - lattice_origin) / cell_m)``."""
+    corner = np.zeros(3) if lattice_origin is None else np.asarray(lattice_origin, float)
+    return np.floor((np.asarray(points, float).reshape(-1, 3) - corner) / cell_m).astype(np.int64)
 
 
 def cell_name(cell: np.ndarray | tuple[int, int, int]) -> str:
@@ -133,10 +153,10 @@ def cell_name(cell: np.ndarray | tuple[int, int, int]) -> str:
     return f"c{i}_{j}_{k}"
 
 
-def _partition(grid: Grid, cell_m: float) -> list[np.ndarray]:
+def _partition(grid: Grid, cell_m: float, corner: np.ndarray) -> list[np.ndarray]:
     """Per axis, the lattice index of each layer of voxels (of its centres)."""
-    return [np.floor((grid.origin[a] + (np.arange(n) + 0.5) * grid.voxel_size_m) / cell_m).astype(np.int64)
-            for a, n in enumerate(grid.shape)]
+    return [np.floor((grid.origin[a] - corner[a] + (np.arange(n) + 0.5) * grid.voxel_size_m) / cell_m)
+            .astype(np.int64) for a, n in enumerate(grid.shape)]
 
 
 def _pack(cells: np.ndarray, partition: list[np.ndarray]) -> np.ndarray:
@@ -159,9 +179,7 @@ def _checked_grid(occupancy: np.ndarray, origin: np.ndarray, voxel_size_m: float
     occ = np.asarray(occupancy)
     if occ.ndim != 3 or not np.issubdtype(occ.dtype, np.integer) or 0 in occ.shape:
         raise ValueError(f"occupancy must be a non-empty 3-D integer grid, got {occ.dtype} {occ.shape}")
-    org = np.asarray(origin, dtype=float).reshape(-1)
-    if org.shape != (3,) or not np.all(np.isfinite(org)):
-        raise ValueError(f"origin must be a finite (x, y, z), got {origin!r}")
+    org = _checked_point(origin, "origin")
     if not _positive(voxel_size_m):
         raise ValueError(f"voxel_size_m must be a positive finite number, got {voxel_size_m!r}")
     if free is not None:
@@ -182,6 +200,16 @@ def _check_parameters(cell_m: float, comm_range_m: float, min_free_voxels: int,
         raise ValueError(f"sight_height_m must be a non-negative finite number, got {sight_height_m!r}")
 
 
+def _checked_point(point: np.ndarray | None, what: str) -> np.ndarray:
+    """A finite (x, y, z) as a float array (None: the world's origin)."""
+    if point is None:
+        return np.zeros(3)
+    p = np.asarray(point, dtype=float).reshape(-1)
+    if p.shape != (3,) or not np.all(np.isfinite(p)):
+        raise ValueError(f"{what} must be a finite (x, y, z), got {point!r}")
+    return p
+
+
 def _non_negative(x: object) -> bool:
     return isinstance(x, (int, float, np.number)) and not isinstance(x, bool) and math.isfinite(x) and x >= 0
 
@@ -190,7 +218,8 @@ def _positive(x: object) -> bool:
     return _non_negative(x) and x > 0  # type: ignore[operator]
 
 
-def _visited_cells(visited: np.ndarray | None, cell_m: float) -> set[tuple[int, int, int]]:
+def _visited_cells(visited: np.ndarray | None, cell_m: float,
+                   corner: np.ndarray) -> set[tuple[int, int, int]]:
     if visited is None:
         return set()
     points = np.asarray(visited, dtype=float)
@@ -198,18 +227,37 @@ def _visited_cells(visited: np.ndarray | None, cell_m: float) -> set[tuple[int, 
         return set()
     if points.ndim != 2 or points.shape[1] != 3 or not np.all(np.isfinite(points)):
         raise ValueError(f"visited must be finite (N, 3) points, got shape {points.shape}")
-    return {tuple(c) for c in lattice_cells(points, cell_m).tolist()}
+    return {tuple(c) for c in lattice_cells(points, cell_m, corner).tolist()}
 
 
-def _standable_mask(grid: Grid, standable: np.ndarray | None) -> np.ndarray:
-    """Dense bool mask of the standable known-free voxels."""
+def _standable_mask(grid: Grid, standable: np.ndarray | None, what: str = "standable") -> np.ndarray:
+    """Dense bool mask of the known-free voxels of ``standable`` (None: all of them)."""
     mask = grid.occupancy == FREE
     if standable is None:
         return mask
     st = np.asarray(standable)
     if st.shape != grid.shape or st.dtype != bool:
-        raise ValueError(f"standable must be a bool mask of shape {grid.shape}, got {st.dtype} {st.shape}")
+        raise ValueError(f"{what} must be a bool mask of shape {grid.shape}, got {st.dtype} {st.shape}")
     return mask & st
+
+
+def _cropped(grid: Grid, masks: list[np.ndarray]) -> tuple[Grid, list[np.ndarray]]:
+    """The grid and masks cut to the box of the known-free voxels and a margin deep
+    enough for the frontier test, so that the dense steps below scale with the
+    mapped part of the world, not the whole map."""
+    free = grid.free_voxels()
+    if len(free) == 0:
+        return grid, masks
+    ijk = np.unravel_index(free, grid.shape)
+    margin = FRONTIER_DEPTH + 1
+    lo = [max(0, int(a.min()) - margin) for a in ijk]
+    hi = [min(n, int(a.max()) + 1 + margin) for a, n in zip(ijk, grid.shape)]
+    box = tuple(slice(a, b) for a, b in zip(lo, hi))
+    shape = tuple(b - a for a, b in zip(lo, hi))
+    sub_free = np.ravel_multi_index(tuple(a - o for a, o in zip(ijk, lo)), shape)
+    sub = Grid(grid.occupancy[box], grid.origin + np.array(lo) * grid.voxel_size_m, grid.voxel_size_m,
+               np.sort(sub_free))
+    return sub, [m[box] for m in masks]
 
 
 # -- components and locations ------------------------------------------------------------
@@ -228,12 +276,13 @@ def _components_within_cells(mask: np.ndarray, partition: list[np.ndarray]) -> n
     return labels[np.ix_(*kept)]
 
 
-def _locations(component: np.ndarray, cell_key: np.ndarray,
+def _locations(component: np.ndarray, cell_key: np.ndarray, stands: np.ndarray,
                min_free_voxels: int) -> tuple[np.ndarray, np.ndarray]:
     """Per component, the number of its location (-1 if it is none); and per location
-    (in key order) its cell's key. A location is a cell's main (largest) component of
-    at least ``min_free_voxels`` voxels; equal sizes go to the lower label."""
-    size = np.bincount(component)
+    (in key order) its cell's key. A location is a cell's main component (the one with
+    the most standable voxels, ``stands``) with at least ``min_free_voxels`` of them;
+    equal counts go to the lower label."""
+    size = np.bincount(component, weights=stands).astype(np.int64)
     comp_cell = np.empty(len(size), dtype=np.int64)
     comp_cell[component] = cell_key
     order = np.lexsort((np.arange(len(size)), -size, comp_cell))
@@ -245,11 +294,11 @@ def _locations(component: np.ndarray, cell_key: np.ndarray,
     return location_of, comp_cell[main]
 
 
-def _positions(world: np.ndarray, location: np.ndarray, lattice: np.ndarray, cell_m: float) -> np.ndarray:
+def _positions(world: np.ndarray, location: np.ndarray, centres: np.ndarray) -> np.ndarray:
     """(L, 3) position of each location: the centre of its voxel (``world``, one row per
-    voxel of ``location``) nearest the cell's centre; ties go to the lowest (x, y, z)."""
-    dist = np.round(np.linalg.norm(world - (lattice[location] + 0.5) * cell_m, axis=1) / _DISTANCE_ROUNDING_M)
-    best = np.full(len(lattice), np.inf)
+    voxel of ``location``) nearest its cell's centre; ties go to the lowest (x, y, z)."""
+    dist = np.round(np.linalg.norm(world - centres[location], axis=1) / _DISTANCE_ROUNDING_M)
+    best = np.full(len(centres), np.inf)
     np.minimum.at(best, location, dist)
     tied = np.flatnonzero(dist == best[location])
     order = tied[np.lexsort((world[tied, 2], world[tied, 1], world[tied, 0], location[tied]))]

@@ -30,12 +30,16 @@ def _pair(u: str, v: str) -> tuple[str, str]:
 class Topology:
     """Locations (name -> position), explored locations and undirected edges.
 
-    ``mobility`` maps an edge (u, v), u < v, to its length in metres."""
+    ``mobility`` maps an edge (u, v), u < v, to its length in metres.
+    ``unreachable``: locations a robot found it cannot get to from a neighbour (on a
+    voxel world, a ledge or a sliver of floor that the map shows connected through
+    free space); they are no frontier's target."""
 
     locations: dict[str, tuple[float, float, float]] = field(default_factory=dict)
     explored: set[str] = field(default_factory=set)
     mobility: dict[tuple[str, str], float] = field(default_factory=dict)
     communication: set[tuple[str, str]] = field(default_factory=set)
+    unreachable: set[str] = field(default_factory=set)
 
     # -- building -------------------------------------------------------------------
     def add_location(self, name: str, pos: Iterable[float], explored: bool = False) -> None:
@@ -69,13 +73,16 @@ class Topology:
         for e, length in other.mobility.items():
             self.mobility.setdefault(e, length)
         self.communication |= other.communication
+        self.unreachable |= other.unreachable
         return self.size() != before
 
     def copy(self) -> "Topology":
-        return Topology(dict(self.locations), set(self.explored), dict(self.mobility), set(self.communication))
+        return Topology(dict(self.locations), set(self.explored), dict(self.mobility), set(self.communication),
+                        set(self.unreachable))
 
-    def size(self) -> tuple[int, int, int, int]:
-        return len(self.locations), len(self.explored), len(self.mobility), len(self.communication)
+    def size(self) -> tuple[int, int, int, int, int]:
+        return (len(self.locations), len(self.explored), len(self.mobility), len(self.communication),
+                len(self.unreachable))
 
     # -- queries ----------------------------------------------------------------------
     def neighbours(self, location: str) -> list[str]:
@@ -84,15 +91,18 @@ class Topology:
         return sorted(out)
 
     def frontiers(self) -> set[str]:
-        """Explored locations with a mobility edge to a location nobody explored."""
+        """Explored locations with a mobility edge to a location nobody explored (and
+        nobody found unreachable)."""
         out = set()
         for u, v in self.mobility:
             if (u in self.explored) != (v in self.explored):
-                out.add(u if u in self.explored else v)
+                inner, outer = (u, v) if u in self.explored else (v, u)
+                if outer not in self.unreachable:
+                    out.add(inner)
         return out
 
     def unexplored_exits(self, location: str) -> list[str]:
-        return [n for n in self.neighbours(location) if n not in self.explored]
+        return [n for n in self.neighbours(location) if n not in self.explored and n not in self.unreachable]
 
     def network(self, base: str, *, spacing_m: float | None = None,
                 communication_cost: float = DEFAULT_COMMUNICATION_COST) -> MCNetwork:
@@ -120,7 +130,8 @@ class Topology:
         return {"locations": {s: list(p) for s, p in sorted(self.locations.items())},
                 "explored": sorted(self.explored),
                 "mobility": [[u, v, round(length, 3)] for (u, v), length in sorted(self.mobility.items())],
-                "communication": [list(e) for e in sorted(self.communication)]}
+                "communication": [list(e) for e in sorted(self.communication)],
+                "unreachable": sorted(self.unreachable)}
 
     @classmethod
     def from_dict(cls, d: Mapping[str, Any]) -> "Topology":
@@ -140,6 +151,10 @@ class Topology:
                     if s not in topo.locations:
                         raise ValueError(f"communication edge {u}-{v} names unknown location '{s}'")
                 topo.add_communication_edge(str(u), str(v))
+            for s in d.get("unreachable", []):
+                if s not in topo.locations:
+                    raise ValueError(f"unreachable location '{s}' is not a location")
+                topo.unreachable.add(str(s))
         except (TypeError, IndexError, AttributeError) as err:
             raise ValueError(f"malformed topology: {err}") from None
         return topo

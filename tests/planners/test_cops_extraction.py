@@ -142,7 +142,7 @@ def test_unconnected_parallel_rooms_in_neighbouring_cells_are_not_joined():
 
 def test_empty_map_has_no_locations():
     occ = np.full((10, 10, 10), UNKNOWN, dtype=np.int8)
-    assert extract_topology(occ, np.zeros(3), V).size() == (0, 0, 0, 0)
+    assert extract_topology(occ, np.zeros(3), V).size() == (0, 0, 0, 0, 0)
 
 
 @pytest.mark.parametrize("kwargs, message", [
@@ -185,3 +185,31 @@ def test_generated_mine_gives_a_connected_network_with_forks(mine, standable):
         assert g.degree(cell_name(cell)) >= 3
     net = topo.network(min(topo.explored), spacing_m=CELL)
     assert len(net) == len(g) and not net.frontiers
+
+
+def test_the_lattice_origin_moves_the_cells():
+    """Cells from x = -4 m, 4 m, 12 m, ...: the corridor from 0.5 m to 40 m spans c0..c5."""
+    occ = corridor()
+    topo = extract_topology(occ, np.zeros(3), V, lattice_origin=np.array([-4.0, 0.0, 0.0]))
+    assert sorted(topo.locations) == [f"c{i}_0_0" for i in range(6)]
+    assert topo.locations["c1_0_0"][0] == pytest.approx(7.75)   # the voxel centre nearest x = 8 m
+    assert lattice_cells(np.array([[3.9, 3.0, 1.0]]), CELL, np.array([-4.0, 0.0, 0.0]))[0].tolist() == [0, 0, 0]
+    with pytest.raises(ValueError, match="lattice_origin"):
+        extract_topology(occ, np.zeros(3), V, lattice_origin=np.array([0.0, np.nan, 0.0]))
+
+
+def test_free_space_joins_floor_seen_in_rings():
+    """A LiDAR sees the floor in rings: standable strips with unseen floor between them.
+    Through the free space above (``passable``) the cells are still joined."""
+    occ = corridor()
+    rings = floor_of(occ)
+    for x0 in range(6, 80, 8):          # every 4 m, a 2 m gap in the seen floor
+        rings[x0:x0 + 4] = False
+    alone = extract_topology(occ, np.zeros(3), V, standable=rings)
+    assert len(alone.mobility) < 4
+    joined = extract_topology(occ, np.zeros(3), V, standable=rings, passable=occ == FREE)
+    names = [f"c{i}_0_0" for i in range(5)]
+    assert set(joined.mobility) == {(names[i], names[i + 1]) for i in range(4)}
+    for pos in joined.locations.values():     # positions stay on the seen floor
+        i, j, k = (np.asarray(pos) / V).astype(int)
+        assert rings[i, j, k]

@@ -89,3 +89,14 @@ def test_recall_hands_m_at_the_end_to_robots_home_without_it():
     _hand_m_at_base(plan, "s0", ["r1", "r2"])
     assert plan.communications[-1] == Communication(3, "base", "r1", MASTER)
     assert plan.master_receivers() == {"base", "r1", "r2"} and not validate_plan(net, plan)
+
+
+def test_an_unreachable_location_is_no_frontier_target_and_travels_with_the_topology():
+    t = chain(5, 3)
+    t.unreachable.add("s3")
+    assert t.frontiers() == set() and t.unexplored_exits("s2") == []
+    other = chain(5, 1)
+    assert other.merge(t) and other.unreachable == {"s3"}
+    assert Topology.from_dict(t.to_dict()).unreachable == {"s3"}
+    with pytest.raises(ValueError, match="unreachable location 'x'"):
+        Topology.from_dict({"locations": {"a": [0, 0, 0]}, "unreachable": ["x"]})
