@@ -7,21 +7,18 @@ fraction of locations explored, and the report adds the COPS plans.
 """
 from __future__ import annotations
 
-import statistics
 from dataclasses import replace
 from typing import Any
 
 import numpy as np
-import py_trees
 from py_trees.common import Status
 
 from ..sim.graph_world import GraphRadioNetwork, GraphRadioSpec, GraphRobot, GraphWorld
 from ..sim.platforms import PLATFORMS
+from .cops_report import cops_figures, declared_lost
 from .runner import BASE, Mission, Sample
 from .scenario import Scenario
 
-#: Blackboard key of the base station's COPS state (skills.cops.CopsState).
-BASE_STATE_KEY = f"/{BASE}/cops"
 
 
 class GraphMission(Mission):
@@ -30,6 +27,7 @@ class GraphMission(Mission):
     def __init__(self, scenario: Scenario, *, seed: int | None = None, duration_s: float | None = None,
                  world: GraphWorld | None = None):
         self._begin(scenario, seed, duration_s, world)
+        self.cops = True
         self.radio = GraphRadioNetwork(GraphRadioSpec(**scenario.radio), self.world,
                                        np.random.default_rng(self.seed), lambda: self.clock.now_s)
         self.robots: dict[str, GraphRobot] = {}
@@ -71,10 +69,6 @@ class GraphMission(Mission):
     def _sense(self, now: float) -> None:
         """Robots explore as they arrive at locations (in ``GraphRobot.step``)."""
 
-    def base_state(self) -> Any:
-        """The base station's COPS state (None before its first tick)."""
-        return py_trees.blackboard.Blackboard.storage.get(BASE_STATE_KEY)
-
     def _sample(self, now: float) -> None:
         n = len(self.world)
         team: set[str] = set()
@@ -96,7 +90,6 @@ class GraphMission(Mission):
     # ---- figures --------------------------------------------------------------------
     def world_figures(self) -> dict[str, Any]:
         """The report's graph-world figures: locations and the COPS plans."""
-        plans = [e for e in self.state.events if e["event"] == "cops_plan"]
         base_done = next((s.t for s in self.state.samples if s.base >= 1.0), None)
         st = self.base_state()
         return {
@@ -106,26 +99,9 @@ class GraphMission(Mission):
             "all_known_at_base_s": base_done,
             "lost_robots": sorted(self.lost),
             "stranded_robots": self.stranded,
-            "declared_lost": sorted({e["robot"] for e in self.state.events if e["event"] == "robot_declared_lost"}),
-            "cops": {
-                "cycles": len(plans),
-                "plans_valid": sum(1 for e in plans if e.get("valid")),
-                "no_plan": [e["reason"] for e in self.state.events if e["event"] in ("cops_no_plan",
-                                                                                      "cops_invalid_plan")],
-                "plans": [{k: e[k] for k in ("cycle", "final", "robots", "locations", "frontiers", "explorers",
-                                             "T_pre", "T_post", "ext_com", "int_com", "transitions", "relayed", "clustered")}
-                          for e in plans],
-            },
+            "declared_lost": declared_lost(self.state.events),
+            "cops": cops_figures(self.state.events),
         }
-
-    def wall_clock_figures(self) -> dict[str, Any]:
-        """Solve times of the COPS plans (wall clock, so left out of comparisons)."""
-        times = [e["solve_time_s"] for e in self.state.events if e["event"] == "cops_plan"
-                 and e.get("solve_time_s") is not None]
-        if not times:
-            return {}
-        return {"cops_solve_time_s": {"median": round(statistics.median(times), 3),
-                                      "max": round(max(times), 3), "total": round(sum(times), 3)}}
 
     def robot_figures(self, name: str) -> dict[str, Any]:
         robot = self.robots[name]

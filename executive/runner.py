@@ -18,9 +18,15 @@ from ..sim.radio import RadioNetwork, RadioSpec
 from ..sim.robot import SimRobot
 from ..sim.voxel_map import VoxelMap
 from ..sim.world import World
+from ..planners.cops.extraction import DEFAULT_CELL_M
+from ..planners.cops.topology import Topology
 from ..skills.base import AgentContext
+from ..skills.cops import CopsSkill
+from ..skills.cops_voxel import VoxelNetworkView
+from ..skills.navigation import navigator
 from ..skills.operator import COMMAND
 from .agent import Agent
+from .cops_report import cops_figures, declared_lost, solve_time_figures
 from .errors import DelveError
 from .scenario import RobotSpec, Scenario
 from .tree_loader import load_tree
@@ -81,6 +87,9 @@ class Mission:
         base_radio = self.radio.add(BASE, lambda: base_pos, breadcrumbs=0)
 
         self._add_agents(radio=base_radio, map=self.base_map)
+        self.cops = BASE in self.agents and any(isinstance(b, CopsSkill) for b in self.agents[BASE].root.iterate())
+        if self.cops:
+            self._start_cops()
         reach = self.world.reachable_free(self._first_start())
         self.truth = np.flatnonzero(reach.reshape(-1))
 
@@ -114,6 +123,35 @@ class Mission:
             ctx.services.update(base_services)
             self.agents[BASE] = Agent(BASE, load_tree(self.scenario.base_tree, ctx),
                                       1.0 / self.scenario.base_tick_hz, ctx, on_change=self._status_changed)
+
+    def _start_cops(self) -> None:
+        """COPS on a voxel world. Every robot's network view uses one lattice, with a
+        cell centred on the first robot's start, and the radio's range; the base
+        station's team (robot -> start location), base location and initial topology
+        come from the robots' first scans, taken here, at the base, where all robots
+        hear it."""
+        corner = self._first_start() - 0.5 * DEFAULT_CELL_M
+        initial, team = Topology(), {}
+        for name, robot in self.robots.items():
+            ctx = self.agents[name].ctx
+            view = VoxelNetworkView(robot, lattice_origin=corner, comm_range_m=self.radio.spec.range_m,
+                                    navigator=navigator(ctx, robot))
+            ctx.services["network_view"] = view
+            robot.scan()
+            self._next_scan[name] = 1.0 / robot.mobility.lidar.rate_hz
+            initial.merge(view.current())
+            team[name] = view.location()
+            if team[name] is None:
+                raise DelveError(f"robot '{name}' does not stand in a location of the COPS network "
+                                 f"at its start", self.scenario.path, self._robot_line(name))
+        base_location = view.cell_of(self._first_start()[None])[0]
+        for name in self.robots:
+            self.agents[name].ctx.services.update(team=team, base_location=base_location)
+        self.agents[BASE].ctx.services.update(team=team, base_location=base_location,
+                                              initial_topology=initial.to_dict())
+
+    def _robot_line(self, name: str) -> int | None:
+        return next(s.line for s in self.scenario.robots if s.name == name)
 
     def _first_start(self) -> np.ndarray:
         r = next(iter(self.robots.values()))
@@ -160,7 +198,10 @@ class Mission:
         return [a for n, a in self.agents.items() if n != BASE and n not in self.lost]
 
     def _done(self) -> bool:
-        """Whether the mission is over: every robot's tree has finished (lost ones aside)."""
+        """Whether the mission is over: every robot's tree has finished (lost ones
+        aside); with COPS, also as soon as the base station fails (no plan)."""
+        if self.cops and self.agents[BASE].root.status == Status.FAILURE:
+            return True
         return all(a.finished for a in self.robot_agents)
 
     def run(self, progress: Callable[["Mission"], None] | None = None, progress_period_s: float = 10.0) -> None:
@@ -253,18 +294,31 @@ class Mission:
 
     # ---- results ----------------------------------------------------------------
     def world_figures(self) -> dict[str, Any]:
-        """Report figures of the world kind (here: the reachable free volume)."""
-        return {"free_volume_m3": round(len(self.truth) * self.world.voxel_size_m ** 3, 1)}
+        """Report figures of the world kind (here: the reachable free volume) and, for
+        COPS, the network and the plans."""
+        out: dict[str, Any] = {"free_volume_m3": round(len(self.truth) * self.world.voxel_size_m ** 3, 1)}
+        st = self.base_state()
+        if st is not None:
+            topo = st.knowledge.topology
+            out.update(locations_known_at_base=len(topo.locations), locations_explored_at_base=len(topo.explored),
+                       declared_lost=declared_lost(self.state.events), cops=cops_figures(self.state.events))
+        return out
+
+    def base_state(self) -> Any:
+        """The base station's COPS state (None without COPS or before its first tick)."""
+        return py_trees.blackboard.Blackboard.storage.get(f"/{BASE}/cops") if self.cops else None
 
     def robot_figures(self, name: str) -> dict[str, Any]:
         """Extra per-robot report figures of the world kind."""
         return {"lost": name in self.lost} if self.lost else {}
 
     def wall_clock_figures(self) -> dict[str, Any]:
-        """Report figures that depend on the wall clock."""
-        return {}
+        """Report figures that depend on the wall clock (COPS solve times)."""
+        return solve_time_figures(self.state.events)
 
     @property
     def succeeded(self) -> bool:
-        """Every robot's tree ended in SUCCESS (robots lost to a fault aside)."""
-        return all(a.root.status == Status.SUCCESS for a in self.robot_agents)
+        """Every robot's tree ended in SUCCESS (robots lost to a fault aside), and with
+        COPS the base station's too."""
+        return all(a.root.status == Status.SUCCESS for a in self.robot_agents) and (
+            not self.cops or self.agents[BASE].root.status == Status.SUCCESS)

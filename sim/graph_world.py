@@ -228,6 +228,10 @@ class GraphRobot(RobotBody):
         loc = self._last_location
         return loc if loc is not None and np.allclose(self._pos, self.world.pos(loc)) else None
 
+    def arrived(self, location: str) -> bool:
+        """At a location is at its position."""
+        return self.location() == location
+
     def route(self, location: str) -> np.ndarray | None:
         """Waypoints along known tunnels to ``location`` (shortest by length)."""
         here = self.location() or self._last_location

@@ -37,6 +37,7 @@ from ..planners.cops.plan import Plan, idle_plan
 from ..planners.cops.recall import solve_recall
 from ..planners.cops.topology import Topology, team_network
 from .base import AgentContext, Param, Skill
+from .robot import PathStatus
 
 KIND = "cops"
 PARTS = ("pre", "explore", "post", "done")
@@ -51,7 +52,10 @@ class Knowledge:
     ``received`` / ``acked``: ids of info messages received / acknowledged to us.
     ``heard[r]``: newest sim time r was heard from (by anyone whose knowledge we have);
     ``declared[r]``: newest time r was declared lost. r counts as lost while it was
-    declared lost after it was last heard from."""
+    declared lost after it was last heard from.
+    ``map_chunks``: on voxel worlds, the pieces of robots' onboard maps this agent
+    holds ("r1/4" -> (flat indices, values)), carried like the rest of the
+    information until they reach the base station's map."""
 
     topology: Topology = field(default_factory=Topology)
     freshness: dict[str, int] = field(default_factory=dict)
@@ -60,6 +64,7 @@ class Knowledge:
     acked: set[str] = field(default_factory=set)
     heard: dict[str, float] = field(default_factory=dict)
     pending_plan: dict[str, Any] | None = None
+    map_chunks: dict[str, tuple[Any, Any]] = field(default_factory=dict)
 
     @property
     def lost(self) -> set[str]:
@@ -67,9 +72,17 @@ class Knowledge:
 
     def payload(self) -> dict[str, Any]:
         return {"topology": self.topology.to_dict(), "freshness": dict(self.freshness),
-                "declared": dict(self.declared), "heard": dict(self.heard)}
+                "declared": dict(self.declared), "heard": dict(self.heard), "map": dict(self.map_chunks)}
+
+    def collect_map(self, robot: str, onboard_map: Any) -> None:
+        """Add what ``robot``'s onboard map gained since the last call as a chunk."""
+        flat, values = onboard_map.take_changes()
+        if len(flat):
+            self.map_chunks[f"{robot}/{len(self.map_chunks)}"] = (flat, values)  # unique: the dict only grows
 
     def absorb(self, payload: dict[str, Any]) -> None:
+        for key, chunk in payload.get("map", {}).items():
+            self.map_chunks.setdefault(key, chunk)
         self.topology.merge(Topology.from_dict(payload["topology"]))
         for mine, theirs in ((self.freshness, payload["freshness"]), (self.declared, payload["declared"]),
                              (self.heard, payload["heard"])):
@@ -143,6 +156,14 @@ class CopsSkill(Skill):
 
     ABSTRACT = True
     PARAMS = {"state": STATE_KEY}
+    #: The location :meth:`drive_to` last sent the robot to, and the last one where
+    #: it found the robot as near the position as it can get.
+    _driving: str | None = None
+    _settled: str | None = None
+
+    def reset_drive(self) -> None:
+        """Forget earlier drives (when the behaviour starts afresh)."""
+        self._driving = self._settled = None
 
     def __init__(self, name: str, ctx: AgentContext, remap: dict[str, str] | None = None, **params: Any):
         super().__init__(name, ctx, remap, **params)
@@ -160,6 +181,41 @@ class CopsSkill(Skill):
     def radio(self) -> Any:
         return self.ctx.robot.radio if self.ctx.robot is not None else self.ctx.services["radio"]
 
+    def greet_home(self, st: "CopsState") -> None:
+        """Greet the leader from the base, with everything the agent holds (what it
+        mapped on its way home included)."""
+        collect_own_map(self.ctx, st.knowledge)
+        self.radio.send(self.p["leader"], KIND, {"type": "hello", "home": True, "payload": st.knowledge.payload()})
+
+    def drive_to(self, there: str, arrive: bool = False) -> Status | None:
+        """Drive towards location ``there`` through the NetworkView: None once there
+        (in its region; with ``arrive``, at the end of its route to the position, or as
+        near the position as the robot can get inside the region), RUNNING on the way,
+        FAILURE when it cannot get there (no route, or blocked). A route that ends short of ``there`` (a voxel map's
+        graph reaches further as the robot walks) is asked for again where it ends."""
+        view, robot = network_view(self.ctx), self.robot
+        inside = view.location() == there
+        on_own_route = self._driving == there and robot.path_status == PathStatus.FOLLOWING \
+            and getattr(self, "_command_id", None) == robot.command_id
+        if inside and (not arrive or not on_own_route and (self._settled == there or view.arrived(there))):
+            self._driving = None
+            return None
+        if self._driving != there or robot.path_status in (PathStatus.ARRIVED, PathStatus.IDLE) \
+                or getattr(self, "_command_id", None) != robot.command_id:
+            route = view.route(there)
+            if route is None and inside:  # as near as it gets
+                self._driving, self._settled = None, there
+                return None
+            if route is None:
+                self.feedback_message = f"no route to {there}"
+                return Status.FAILURE
+            self.follow(route)
+            self._driving = there
+        if robot.path_status == PathStatus.BLOCKED:
+            self.feedback_message = f"blocked on the way to {there}"
+            return Status.FAILURE
+        return Status.RUNNING
+
 
 class InformationStorage(CopsSkill):
     """Background task: listen, acknowledge, store.
@@ -168,8 +224,11 @@ class InformationStorage(CopsSkill):
     (duplicates too), merges its payload into the agent's knowledge and, for a newer
     plan m, keeps it for ``WaitToReceivePlan``; it records acknowledgements and when
     each sender was last heard. Once it has made the final plan, it answers a robot
-    greeting it from the base with that plan. When the robot reaches a new location
-    it merges what its own sensing revealed and marks its own information fresh.
+    greeting it from the base with that plan. When the robot reaches a new location,
+    or its NetworkView's ``revision`` changes (a voxel map extracted again), it
+    merges what its own sensing revealed and marks its own information fresh, and
+    takes what its onboard map gained into its knowledge. The base station merges the
+    map chunks that reach it into its map (service ``map``).
 
     Reads/writes: ``cops`` (knowledge). Returns RUNNING.
     """
@@ -179,6 +238,7 @@ class InformationStorage(CopsSkill):
     def __init__(self, name: str, ctx: AgentContext, remap: dict[str, str] | None = None, **params: Any):
         super().__init__(name, ctx, remap, **params)
         self._at: Any = ()
+        self._merged: set[str] = set()
 
     def initialise(self) -> None:
         initial = self.ctx.services.get("initial_topology")
@@ -194,6 +254,8 @@ class InformationStorage(CopsSkill):
                 continue
             d = msg.data
             kn.heard[msg.sender] = now
+            if d["type"] == "hello" and "payload" in d:
+                kn.absorb(d["payload"])
             if d["type"] == "hello" and d.get("home") and st.final:
                 self._hand_final_plan(msg.sender, st)
             elif d["type"] == "ack":
@@ -208,6 +270,7 @@ class InformationStorage(CopsSkill):
                         kn.pending_plan is None or d["cycle"] > kn.pending_plan["cycle"]):
                     kn.pending_plan = d
         self._sense(st)
+        self._merge_maps(kn)
         return Status.RUNNING
 
     def _hand_final_plan(self, robot: str, st: CopsState) -> None:
@@ -221,12 +284,30 @@ class InformationStorage(CopsSkill):
         view = network_view(self.ctx)
         if view is None:
             return
-        at = view.location()
+        at = (view.location(), getattr(view, "revision", None))
         if at == self._at:
             return
         self._at = at
         if st.knowledge.topology.merge(Topology.from_dict(view.topology())):
             st.knowledge.freshness[self.ctx.name] = max(st.cycle, 0)
+        collect_own_map(self.ctx, st.knowledge)
+
+    def _merge_maps(self, kn: Knowledge) -> None:
+        """Base station: merge the map chunks that arrived into its map (service ``map``)."""
+        base_map = self.ctx.services.get("map")
+        if base_map is None:
+            return
+        for key in sorted(kn.map_chunks.keys() - self._merged):
+            base_map.merge(*kn.map_chunks[key])
+            self._merged.add(key)
+
+
+def collect_own_map(ctx: AgentContext, kn: Knowledge) -> None:
+    """Put what the agent's robot mapped since the last call into its knowledge (robots
+    with an onboard voxel map only)."""
+    onboard = getattr(ctx.robot, "onboard_map", None)
+    if onboard is not None:
+        kn.collect_map(ctx.name, onboard)
 
 
 class IsLeader(Skill):
@@ -428,26 +509,26 @@ class ReturnWithoutPlan(CopsSkill):
 
     def initialise(self) -> None:
         self._since = self.ctx.clock.now_s
-        self._sent = False
+        self._sent = self._stranded = False
+        self.reset_drive()
         self._greeted = -math.inf
 
     def update(self) -> Status:
         st, now = self.state, self.ctx.clock.now_s
         if self.ctx.robot is None or st.plan is None:
             return Status.RUNNING
-        if self._sent:
-            if network_view(self.ctx).location() == st.base_location and now - self._greeted >= \
-                    self.p["greet_period_s"]:
-                self._greeted = now
-                self.radio.send(self.p["leader"], KIND, {"type": "hello", "home": True})
+        if now - self._since < st.recall_after_s:
             return Status.RUNNING
-        if now - self._since >= st.recall_after_s:
-            view = network_view(self.ctx)
-            route = view.route(st.base_location) if view.location() != st.base_location else None
-            if route is not None:
-                self.follow(route)
-                self.event("return_without_plan", cycle=st.cycle)
+        home = network_view(self.ctx).location() == st.base_location
+        if not self._sent:
             self._sent = True
+            if not home:
+                self.event("return_without_plan", cycle=st.cycle)
+        if not self._stranded and self.drive_to(st.base_location, arrive=True) == Status.FAILURE:
+            self._stranded = True  # no way home: wait where it is
+        if home and now - self._greeted >= self.p["greet_period_s"]:
+            self._greeted = now
+            self.greet_home(st)
         return Status.RUNNING
 
     def terminate(self, new_status: Status) -> None:
@@ -529,7 +610,7 @@ class MissionComplete(CopsSkill):
             return Status.SUCCESS
         if now - self._greeted >= self.p["greet_period_s"]:
             self._greeted = now
-            self.radio.send(self.p["leader"], KIND, {"type": "hello", "home": True})
+            self.greet_home(st)
         self.feedback_message = f"home: telling {self.p['leader']}"
         return Status.RUNNING
 
@@ -617,6 +698,7 @@ class CommunicationAction(CopsSkill):
         if now - self._sent.get(mid, -math.inf) < self.p["resend_period_s"]:
             return
         self._sent[mid] = now
+        collect_own_map(self.ctx, st.knowledge)
         payload = st.knowledge.payload()
         if c.info == MASTER:
             payload["plan"] = st.plan_message()
@@ -645,7 +727,7 @@ class TransitionAction(CopsSkill):
     """
 
     def initialise(self) -> None:
-        self._target: str | None = None
+        self.reset_drive()
 
     def update(self) -> Status:
         st = self.state
@@ -653,7 +735,8 @@ class TransitionAction(CopsSkill):
         if plan is None:
             return Status.FAILURE
         last = st.step >= plan.horizon
-        moving = self._go(plan.location(self.ctx.name, min(st.step + 1, plan.horizon)))
+        moving = self.drive_to(plan.location(self.ctx.name, min(st.step + 1, plan.horizon)), arrive=True) \
+            if self.ctx.robot is not None else None
         if moving is not None:
             return moving
         if last:
@@ -661,25 +744,6 @@ class TransitionAction(CopsSkill):
         else:
             st.step += 1
         return Status.SUCCESS
-
-    def _go(self, there: str) -> Status | None:
-        """Drive to ``there``: None once there, else RUNNING (FAILURE when it cannot)."""
-        if self.ctx.robot is None:
-            return None
-        view = network_view(self.ctx)
-        if view.location() == there:
-            return None
-        if self._target != there:
-            route = view.route(there)
-            if route is None:
-                self.feedback_message = f"no route to {there}"
-                return Status.FAILURE
-            self.follow(route)
-            self._target = there
-        if self.robot.path_status == "blocked":
-            self.feedback_message = f"blocked on the way to {there}"
-            return Status.FAILURE
-        return Status.RUNNING
 
     def _next_part(self, st: CopsState) -> None:
         if st.part == "pre":
@@ -749,11 +813,13 @@ class ExplorationAction(CopsSkill):
     Starting at its frontier with frontier index i, the robot repeats: c = number of
     choices (at the frontier: its unexplored exits; further on: the tunnels other than
     the one it came by), choice = i mod c, i = i div c, move one location towards the
-    choice. Robots sent to one frontier thus spread over its branches (Figure 5). At a
-    dead end it waits. Runs until the Exploration Timer stops it.
+    choice. Robots sent to one frontier thus spread over its branches (Figure 5). A
+    choice the robot cannot reach (no route, or blocked) is dropped and the robot
+    chooses again among the others, with i as it was. At a dead end it waits. Runs
+    until the Exploration Timer stops it.
 
     Reads ``cops`` (the plan's exploration task and network); drives the robot.
-    Logs ``exploration_choice``. Returns RUNNING (FAILURE if a move is impossible).
+    Logs ``exploration_choice`` and ``exploration_unreachable``. Returns RUNNING.
     """
 
     def initialise(self) -> None:
@@ -761,23 +827,32 @@ class ExplorationAction(CopsSkill):
         task = st.plan.exploration[self.ctx.name]
         self._i, self._at, self._prev = task.index, task.frontier, None
         self._moving: str | None = None
+        self.reset_drive()
+        self._i_before = self._i
         self._visited = {task.frontier}
         st.knowledge.freshness[self.ctx.name] = st.cycle
 
     def update(self) -> Status:
         st = self.state
-        view = network_view(self.ctx)
         topo = st.knowledge.topology
         if self._moving is not None:
-            if view.location() != self._moving:
-                return Status.FAILURE if self.robot.path_status == "blocked" else Status.RUNNING
+            moving = self.drive_to(self._moving)
+            if moving == Status.RUNNING:
+                return moving
+            if moving == Status.FAILURE:
+                self.event("exploration_unreachable", at=self._at, choice=self._moving)
+                topo.unreachable.add(self._moving)
+                self._visited.add(self._moving)
+                self._i, self._moving = self._i_before, None
+                return Status.RUNNING
             self._prev, self._at, self._moving = self._at, self._moving, None
             self._visited.add(self._at)
         if self._prev is None:
-            explored = set(st.plan.meta.get("explored", ()))
+            explored = set(st.plan.meta.get("explored", ())) | self._visited | topo.unreachable
             cands = [s for s in topo.neighbours(self._at) if s not in explored]
         else:
-            cands = [s for s in topo.neighbours(self._at) if s != self._prev and s not in self._visited]
+            cands = [s for s in topo.neighbours(self._at)
+                     if s != self._prev and s not in self._visited and s not in topo.unreachable]
         choices = ordered_choices(topo, self._at, self._prev, cands)
         if not choices:
             self.feedback_message = f"dead end at {self._at}"
@@ -785,12 +860,7 @@ class ExplorationAction(CopsSkill):
         c = len(choices)
         choice, i = choices[self._i % c], self._i // c
         self.event("exploration_choice", at=self._at, choices=choices, index=self._i, choice=choice)
-        self._i = i
-        route = view.route(choice)
-        if route is None:
-            return Status.FAILURE
-        self.follow(route)
-        self._moving = choice
+        self._i_before, self._i, self._moving = self._i, i, choice
         self.feedback_message = f"to {choice} (i={self._i})"
         return Status.RUNNING
 
@@ -807,20 +877,13 @@ class TransitToReturnNode(CopsSkill):
     """
 
     def initialise(self) -> None:
-        self._sent = False
+        self.reset_drive()
 
     def update(self) -> Status:
         st = self.state
-        frontier = st.plan.exploration[self.ctx.name].frontier
-        view = network_view(self.ctx)
-        if view.location() != frontier:
-            if not self._sent:
-                route = view.route(frontier)
-                if route is None:
-                    return Status.FAILURE
-                self.follow(route)
-                self._sent = True
-            return Status.FAILURE if self.robot.path_status == "blocked" else Status.RUNNING
+        moving = self.drive_to(st.plan.exploration[self.ctx.name].frontier, arrive=True)
+        if moving is not None:
+            return moving
         st.part, st.step = "post", 0
         return Status.SUCCESS
 

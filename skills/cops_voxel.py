@@ -5,12 +5,16 @@ robot with an onboard voxel map. The network is extracted from what the robot ha
 mapped (:func:`delve.planners.cops.extraction.extract_topology`): locations are the
 cells of a fixed world lattice, so every robot names a place the same way.
 
-The robot's navigation graph (:mod:`delve.skills.navigation`) says where it can go:
-a legged robot stands on the voxels that are nodes of its legged graph (and, when
-it steps higher than a voxel, on the risers of its steps); a flying robot flies
-through the known-free voxels around the nodes of its aerial graph. Routes to a
-location are shortest paths on the same graph. The cells the robot has passed
-through (its traversed path) count as explored.
+The robot's navigation graph (:mod:`delve.skills.navigation`) says where it can
+stand: a legged robot on the voxels that are nodes of its legged graph (and, when it
+steps higher than a voxel, on the risers of its steps), a flying robot in the
+known-free voxels around the nodes of its aerial graph. Connectivity, though, is
+that of the known free space: a LiDAR sees a tunnel's floor in rings, so the
+standable voxels of one scan are rings with gaps between them that the free space
+above spans. Routes to a location are shortest paths on the navigation graph; where
+the graph does not reach a location yet, the route leads to the reachable node
+nearest it, and the robot asks again there, with more of the floor mapped. The cells
+the robot has passed through (its traversed path) count as explored.
 """
 from __future__ import annotations
 
@@ -31,12 +35,18 @@ from ..planners.cops.topology import Topology
 from ..planners.navgraph import NavGraph
 from ..planners.occupancy import FREE, Grid
 from .base import AgentContext
-from .navigation import Navigator
+from .navigation import Navigator, Plan
 from .robot import Robot
 
 #: Flying robots' standable voxels: the free voxels within this many voxels of a node
 #: of the aerial graph (whose nodes lie on a lattice of every second voxel).
 AERIAL_NODE_REACH_VOXELS = 1
+#: A robot this near a location's position (m) has arrived there: a route ends at
+#: the graph node nearest the position, within the navigator's snap radii.
+ARRIVAL_RADIUS_M = 2.5
+#: A partial route (towards a location the graph does not reach yet) must end at
+#: least this much nearer the location than the robot is, metres.
+MIN_PROGRESS_M = 1.0
 #: Rounding allowance when counting how many voxels a legged robot's step spans (as
 #: ``legged_graph`` counts it).
 _STEP_TOLERANCE_VOXELS = 1e-9
@@ -51,25 +61,30 @@ class _MapClock:
 class VoxelNetworkView:
     """The COPS network a robot's onboard map reveals (the ``NetworkView`` protocol).
 
-    ``topology()`` is extracted again whenever the map, the navigation graph or the
-    robot's traversed path has changed since the last call. Pass the agent's shared ``navigator``
+    ``topology()`` is extracted again whenever the navigation graph has been rebuilt
+    (the navigator rebuilds it when the map has changed) since the last call; the
+    cells of the traversed path are marked explored on every call. Pass the agent's shared ``navigator``
     (:func:`delve.skills.navigation.navigator`) to plan on one graph per agent; by
-    default the view keeps its own, rebuilt on every map change.
+    default the view keeps its own, rebuilt on every map change. Robots of one team
+    share ``lattice_origin`` (see :func:`extract_topology`).
     """
 
     def __init__(self, robot: Robot, *, cell_m: float = DEFAULT_CELL_M,
                  comm_range_m: float = DEFAULT_COMM_RANGE_M, min_free_voxels: int = DEFAULT_MIN_FREE_VOXELS,
-                 navigator: Navigator | None = None):
+                 navigator: Navigator | None = None, lattice_origin: np.ndarray | None = None):
         if not (isinstance(cell_m, (int, float)) and math.isfinite(cell_m) and cell_m > 0):
             raise ValueError(f"cell_m must be a positive finite number, got {cell_m!r}")
         self.robot = robot
+        self.lattice_origin = np.zeros(3) if lattice_origin is None else np.asarray(lattice_origin, float)
         self.cell_m = float(cell_m)
         self.comm_range_m = float(comm_range_m)
         self.min_free_voxels = min_free_voxels
         self.navigator = navigator if navigator is not None else Navigator(
             robot, _own_context(robot), rebuild_period_s=0.0)
-        self._key: tuple[int, NavGraph, int] | None = None
+        self._graph: NavGraph | None = None
         self._topology = Topology()
+        self._visited: set[str] = set()
+        self._trail_seen = 0
         self.extractions = 0
 
     # -- the NetworkView protocol ---------------------------------------------------------
@@ -79,34 +94,75 @@ class VoxelNetworkView:
 
     def location(self) -> str | None:
         """The location whose cell holds the robot's ground point, or None."""
-        name = cell_name(lattice_cells(self.ground_point()[None], self.cell_m)[0])
+        name = self.cell_of(self.ground_point()[None])[0]
         return name if name in self.current().locations else None
+
+    def arrived(self, location: str) -> bool:
+        """Whether the robot's ground point is within ``ARRIVAL_RADIUS_M`` of the location's position."""
+        pos = self.current().locations.get(location)
+        return pos is not None and float(np.linalg.norm(self.ground_point() - pos)) <= ARRIVAL_RADIUS_M
 
     def route(self, location: str) -> np.ndarray | None:
         """Waypoints (N, 3) along the navigation graph from the robot to the node nearest
-        the location's position; None for an unknown location or when none is reachable."""
+        the location's position or, when the graph does not reach it yet, to the
+        reachable node nearest it (if that is ``MIN_PROGRESS_M`` nearer than the robot);
+        None for an unknown location or when no such node is reachable."""
         pos = self.current().locations.get(location)
         if pos is None:
             return None
-        path, _ = self.navigator.path_to_point(np.asarray(pos) + [0.0, 0.0, self.sight_height_m()])
-        return path
+        goal = np.asarray(pos) + [0.0, 0.0, self.sight_height_m()]
+        plan, target = self._plan_towards(goal, force=False)
+        if target is None:
+            plan, target = self._plan_towards(goal, force=True)
+        if plan is None:
+            return None
+        if target is None:
+            reachable = np.flatnonzero(np.isfinite(plan.distances))
+            gap = np.linalg.norm(plan.graph.positions[reachable] - goal, axis=1)
+            target = int(reachable[np.argmin(gap)])
+            if gap.min() > np.linalg.norm(np.asarray(self.robot.position) - goal) - MIN_PROGRESS_M:
+                return None
+        return plan.path_to(target)
+
+    def _plan_towards(self, goal: np.ndarray, force: bool) -> tuple[Plan | None, int | None]:
+        """Shortest paths from the robot (on a graph rebuilt first if ``force``) and the
+        node nearest ``goal`` if it is reachable."""
+        plan = self.navigator.from_robot(force=force)
+        if plan is None:
+            return None, None
+        target = self.navigator.node_near(plan.graph, goal)
+        return plan, target if target is not None and np.isfinite(plan.distances[target]) else None
+
+    def cell_of(self, points: np.ndarray) -> list[str]:
+        """The names of the lattice cells of ground points (N, 3)."""
+        return [cell_name(c) for c in lattice_cells(points, self.cell_m, self.lattice_origin)]
+
+    @property
+    def revision(self) -> tuple[int, int]:
+        """Changes whenever the topology may have: (extractions, visited cells)."""
+        self.current()
+        return self.extractions, len(self._visited)
 
     # -- helpers ----------------------------------------------------------------------------
     def current(self) -> Topology:
-        """The cached :class:`Topology`, extracted again if the map, the navigation
-        graph or the robot's traversed path changed."""
+        """The cached :class:`Topology`, extracted again if the navigation graph was
+        rebuilt, with the cells of the traversed path marked explored."""
         graph = self.navigator.graph()
-        trail = np.asarray(self.robot.traversed_path, dtype=float).reshape(-1, 3)
-        version, visits = self.robot.onboard_map.version, len(trail)
-        if self._key is None or self._key[1] is not graph or (self._key[0], self._key[2]) != (version, visits):
+        if graph is not self._graph:
             grid = self.navigator.grid()
             self._topology = extract_topology(
                 grid.occupancy, grid.origin, grid.voxel_size_m, standable=self.standable(grid, graph),
-                free=grid.free, cell_m=self.cell_m, comm_range_m=self.comm_range_m,
-                min_free_voxels=self.min_free_voxels, sight_height_m=self.sight_height_m(),
-                visited=self.ground_points(trail))
-            self._key = (version, graph, visits)
+                passable=grid.occupancy == FREE, free=grid.free, cell_m=self.cell_m,
+                comm_range_m=self.comm_range_m, min_free_voxels=self.min_free_voxels,
+                sight_height_m=self.sight_height_m(), lattice_origin=self.lattice_origin)
+            self._graph = graph
             self.extractions += 1
+        trail = self.robot.traversed_path
+        if len(trail) > self._trail_seen:
+            new = np.asarray(trail[self._trail_seen:], dtype=float).reshape(-1, 3)
+            self._visited.update(self.cell_of(self.ground_points(new)))
+            self._trail_seen = len(trail)
+        self._topology.explored |= self._visited & self._topology.locations.keys()
         return self._topology
 
     def standable(self, grid: Grid, graph: NavGraph) -> np.ndarray:

@@ -262,5 +262,9 @@ class NetworkView(Protocol):
     def location(self) -> str | None:
         """The location the robot stands at, or None between locations."""
 
+    def arrived(self, location: str) -> bool:
+        """Whether the robot stands at ``location``'s position (where the plan has it
+        communicate), not only in its region."""
+
     def route(self, location: str) -> np.ndarray | None:
         """Waypoints (N x 3) from the robot to a known ``location``, None if no route."""

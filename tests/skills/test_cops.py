@@ -3,13 +3,14 @@ from __future__ import annotations
 
 from types import SimpleNamespace
 
+import numpy as np
 import py_trees
 import pytest
-from delve.planners.cops.plan import Communication, CyclePlan, Plan
+from delve.planners.cops.plan import Communication, CyclePlan, ExplorationTask, Plan
 from delve.planners.cops.topology import Topology
 from delve.skills.base import AgentContext
-from delve.skills.cops import (CommunicationAction, InformationStorage, MissionComplete, TransitionAction,
-                               message_id)
+from delve.skills.cops import (CommunicationAction, ExplorationAction, InformationStorage, Knowledge,
+                               MissionComplete, TransitionAction, message_id)
 from py_trees.common import Status
 
 
@@ -131,6 +132,9 @@ class Walker:
     def location(self) -> str | None:
         return f"s{self.at}"
 
+    def arrived(self, location: str) -> bool:
+        return location == self.location()
+
     def route(self, location: str) -> list[float]:
         return [float(location[1:])]
 
@@ -151,6 +155,45 @@ def test_a_robot_away_from_the_plan_goes_to_its_place_before_the_part_ends():
         robot.step()
     action.tick_once()
     assert action.status == Status.SUCCESS and robot.location() == "s0" and st.part == "post"
+    py_trees.blackboard.Blackboard.clear()
+
+
+class BlockedWalker(Walker):
+    """A Walker that cannot get to the locations in ``blocked``."""
+
+    def __init__(self, at: int, blocked: set[str]) -> None:
+        super().__init__(at)
+        self.blocked = blocked
+
+    def route(self, location: str) -> list[float] | None:
+        return None if location in self.blocked else super().route(location)
+
+
+def test_an_unreachable_choice_is_dropped_and_reported():
+    """At a fork s1 | s2 (s1 first clockwise), s1 cannot be reached: Algorithm 1
+    chooses again among the rest with the same index, and the knowledge says why."""
+    py_trees.blackboard.Blackboard.clear()
+    robot = BlockedWalker(at=0, blocked={"s1"})
+    events = []
+    ctx = AgentContext(name="r1", namespace="/r1", clock=SimpleNamespace(now_s=0.0),
+                       log=lambda event, **f: events.append((event, f)), robot=robot,
+                       services={"network_view": robot})
+    action = ExplorationAction("Exploration action", ctx)
+    st = action.state
+    topo = st.knowledge.topology
+    for name, y in (("s0", 0.0), ("s1", 50.0), ("s2", -50.0)):
+        topo.add_location(name, (0.0, y, 0.0), explored=name == "s0")
+    topo.add_mobility_edge("s0", "s1")
+    topo.add_mobility_edge("s0", "s2")
+    idle = Plan(horizon=0, trajectories={"r1": ["s0"]}, masters=["r1"], phase="pre")
+    st.plan = CyclePlan(idle, idle, {"r1": ExplorationTask("s0", 0, 0, 4, 0)})
+    for _ in range(6):
+        action.tick_once()
+        robot.step()
+    assert [f["choice"] for e, f in events if e == "exploration_choice"] == ["s1", "s2"]
+    assert [f["choice"] for e, f in events if e == "exploration_unreachable"] == ["s1"]
+    assert topo.unreachable == {"s1"} and robot.location() == "s2"
+    assert action.status == Status.RUNNING
     py_trees.blackboard.Blackboard.clear()
 
 
@@ -193,7 +236,9 @@ def test_a_robot_home_greets_the_leader_until_it_answers():
     radio = Radio()
     ctx, storage, done, st = final_state("r1", {"radio": radio})
     done.tick_once()
-    assert done.status == Status.RUNNING and radio.sent == [("base", "cops", {"type": "hello", "home": True})]
+    assert done.status == Status.RUNNING and [(to, kind, d["type"], d["home"]) for to, kind, d in radio.sent] == \
+        [("base", "cops", "hello", True)]
+    assert radio.sent[0][2]["payload"]["topology"] == st.knowledge.topology.to_dict()  # with what it holds
     radio.inbox.append(SimpleNamespace(sender="base", kind="cops", data={
         "type": "info", "id": "6:final:r1", "cycle": 6, "part": "done", "t": 0, "info": "m",
         "payload": {"topology": Topology().to_dict(), "freshness": {}, "declared": {}, "heard": {}}}))
@@ -203,3 +248,27 @@ def test_a_robot_home_greets_the_leader_until_it_answers():
     ctx.clock.now_s += 10.0
     done.tick_once()
     assert done.status == Status.SUCCESS
+
+
+class ChangingMap:
+    """An onboard map whose changes are handed out once each."""
+
+    def __init__(self, *changes) -> None:
+        self.changes = list(changes)
+
+    def take_changes(self):
+        return self.changes.pop(0) if self.changes else (np.zeros(0, np.int64), np.zeros(0, np.int8))
+
+
+def test_map_chunks_travel_with_the_knowledge_and_are_never_taken_twice():
+    robot, relay, base = Knowledge(), Knowledge(), Knowledge()
+    onboard = ChangingMap((np.array([1, 2]), np.array([0, 1], np.int8)), (np.array([3]), np.array([0], np.int8)))
+    robot.collect_map("r1", onboard)
+    relay.absorb(robot.payload())
+    robot.collect_map("r1", onboard)
+    robot.collect_map("r1", onboard)          # nothing new: no chunk
+    base.absorb(relay.payload())
+    base.absorb(robot.payload())
+    assert sorted(base.map_chunks) == sorted(robot.map_chunks) and len(base.map_chunks) == 2
+    merged = np.concatenate([flat for flat, _ in base.map_chunks.values()])
+    assert sorted(merged.tolist()) == [1, 2, 3]

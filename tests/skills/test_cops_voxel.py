@@ -10,7 +10,7 @@ from delve.sim.radio import RadioNetwork, RadioSpec
 from delve.sim.robot import SimRobot
 from delve.sim.world import World
 from delve.sim.worldgen_geometry import VoxelCanvas, carve_tunnel, free_space_mesh
-from delve.skills.cops_voxel import VoxelNetworkView
+from delve.skills.cops_voxel import MIN_PROGRESS_M, VoxelNetworkView
 
 V = 0.2
 DT_S = 0.2          # one sim step, one sweep of the sensors
@@ -103,3 +103,45 @@ def test_aerial_robot_flies_through_its_cells(tunnel):
 def test_bad_cell_size_is_refused(tunnel):
     with pytest.raises(ValueError, match="cell_m"):
         VoxelNetworkView(robot_in(tunnel), cell_m=0.0)
+
+
+def test_routes_lead_towards_every_location_the_map_shows(scanned):
+    """Where the graph does not reach a location yet (floor seen only in rings far
+    ahead), the route ends at the reachable node nearest it."""
+    robot, view = scanned
+    here = view.location()
+    for name, pos in view.current().locations.items():
+        if name == here:
+            continue
+        path = view.route(name)
+        assert path is not None, name
+        ahead = np.linalg.norm(path[-1] - pos)
+        assert ahead < np.linalg.norm(robot.position - pos) - MIN_PROGRESS_M
+
+
+def test_arrival_is_at_the_position_not_only_in_the_cell(tunnel):
+    robot = robot_in(tunnel)
+    walk(robot, 9.0)                           # into c1_0_0, whose position is near x = 12 m
+    view = VoxelNetworkView(robot)
+    assert view.location() == "c1_0_0" and not view.arrived("c1_0_0")
+    robot.follow_path(view.route("c1_0_0"))
+    while robot.path_status == "following":
+        robot.step(DT_S)
+    assert view.arrived("c1_0_0") and not view.arrived("c0_0_0") and not view.arrived("c9_9_9")
+
+
+def test_the_lattice_origin_names_the_cells(scanned):
+    robot, _ = scanned
+    view = VoxelNetworkView(robot, lattice_origin=np.array([-4.0, 0.0, 0.0]))
+    assert view.location() == "c2_0_0"         # x = 13 m lies in [12, 20)
+    assert view.cell_of(np.array([[3.9, 4.0, 0.1], [4.0, 4.0, 0.1]])) == ["c0_0_0", "c1_0_0"]
+
+
+def test_the_revision_moves_with_extractions_and_visits(tunnel):
+    robot = robot_in(tunnel)
+    robot.scan()
+    view = VoxelNetworkView(robot)
+    first = view.revision
+    assert view.revision == first
+    walk(robot, 10.0)
+    assert view.revision != first and "c1_0_0" in view.current().explored

@@ -1,0 +1,34 @@
+"""Report figures of a COPS mission (graph or voxel world), read from its events."""
+from __future__ import annotations
+
+import statistics
+from typing import Any
+
+#: Per plan, the fields of its ``cops_plan`` event that the report keeps.
+PLAN_FIELDS = ("cycle", "final", "robots", "locations", "frontiers", "explorers", "T_pre", "T_post", "ext_com",
+               "int_com", "transitions", "relayed", "clustered")
+
+
+def cops_figures(events: list[dict[str, Any]]) -> dict[str, Any]:
+    """Cycles, plans that passed the validator, why planning failed, and each plan."""
+    plans = [e for e in events if e["event"] == "cops_plan"]
+    return {
+        "cycles": len(plans),
+        "plans_valid": sum(1 for e in plans if e.get("valid")),
+        "no_plan": [e["reason"] for e in events if e["event"] in ("cops_no_plan", "cops_invalid_plan")],
+        "plans": [{k: e[k] for k in PLAN_FIELDS} for e in plans],
+    }
+
+
+def declared_lost(events: list[dict[str, Any]]) -> list[str]:
+    """Robots some agent declared lost."""
+    return sorted({e["robot"] for e in events if e["event"] == "robot_declared_lost"})
+
+
+def solve_time_figures(events: list[dict[str, Any]]) -> dict[str, Any]:
+    """Median, longest and total solve time of the plans (wall clock)."""
+    times = [e["solve_time_s"] for e in events if e["event"] == "cops_plan" and e.get("solve_time_s") is not None]
+    if not times:
+        return {}
+    return {"cops_solve_time_s": {"median": round(statistics.median(times), 3),
+                                  "max": round(max(times), 3), "total": round(sum(times), 3)}}
