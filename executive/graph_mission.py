@@ -11,7 +11,6 @@ from dataclasses import replace
 from typing import Any
 
 import numpy as np
-from py_trees.common import Status
 
 from ..sim.graph_world import GraphRadioNetwork, GraphRadioSpec, GraphRobot, GraphWorld
 from ..sim.platforms import PLATFORMS
@@ -51,21 +50,6 @@ class GraphMission(Mission):
         self.truth = np.arange(len(self.world))
 
     # ---- the loop's hooks ---------------------------------------------------------
-    def _done(self) -> bool:
-        """Over when the base station's tree has finished and every robot's too (lost
-        robots aside), or as soon as the base station fails (no plan)."""
-        base = self.agents[BASE]
-        if base.root.status == Status.FAILURE:
-            return True
-        stranded = set(self.stranded)
-        return base.finished and all(a.finished or a.name in stranded for a in self.robot_agents)
-
-    @property
-    def stranded(self) -> list[str]:
-        """Robots the final plan (the recall) could not reach."""
-        st = self.base_state()
-        return list(st.plan.meta.get("stranded", ())) if st is not None and st.final and st.plan else []
-
     def _sense(self, now: float) -> None:
         """Robots explore as they arrive at locations (in ``GraphRobot.step``)."""
 
@@ -82,10 +66,6 @@ class GraphMission(Mission):
             t=now, team=round(len(team) / n, 5), base=round(base, 5), robots=per_robot,
             positions={k: [round(float(v), 3) for v in r.position] for k, r in self.robots.items()},
             linked={k: self.radio.linked(k, BASE) for k in self.robots}))
-
-    @property
-    def succeeded(self) -> bool:
-        return super().succeeded and self.agents[BASE].root.status == Status.SUCCESS
 
     # ---- figures --------------------------------------------------------------------
     def world_figures(self) -> dict[str, Any]:

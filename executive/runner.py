@@ -199,10 +199,21 @@ class Mission:
 
     def _done(self) -> bool:
         """Whether the mission is over: every robot's tree has finished (lost ones
-        aside); with COPS, also as soon as the base station fails (no plan)."""
-        if self.cops and self.agents[BASE].root.status == Status.FAILURE:
+        aside). With COPS, the base station's tree too (robots the final plan could not
+        reach aside), or as soon as the base station fails (no plan)."""
+        if not self.cops:
+            return all(a.finished for a in self.robot_agents)
+        base = self.agents[BASE]
+        if base.root.status == Status.FAILURE:
             return True
-        return all(a.finished for a in self.robot_agents)
+        stranded = set(self.stranded)
+        return base.finished and all(a.finished or a.name in stranded for a in self.robot_agents)
+
+    @property
+    def stranded(self) -> list[str]:
+        """Robots the final plan (the recall) could not reach."""
+        st = self.base_state()
+        return list(st.plan.meta.get("stranded", ())) if st is not None and st.final and st.plan else []
 
     def run(self, progress: Callable[["Mission"], None] | None = None, progress_period_s: float = 10.0) -> None:
         """Run until every robot's tree has finished or ``duration_s`` has passed,

@@ -195,13 +195,12 @@ class CopsSkill(Skill):
         graph reaches further as the robot walks) is asked for again where it ends."""
         view, robot = network_view(self.ctx), self.robot
         inside = view.location() == there
-        on_own_route = self._driving == there and robot.path_status == PathStatus.FOLLOWING \
-            and getattr(self, "_command_id", None) == robot.command_id
-        if inside and (not arrive or not on_own_route and (self._settled == there or view.arrived(there))):
+        on_own_route = self._driving == there and getattr(self, "_command_id", None) == robot.command_id
+        if inside and (not arrive or not (on_own_route and robot.path_status == PathStatus.FOLLOWING)
+                       and (self._settled == there or view.arrived(there))):
             self._driving = None
             return None
-        if self._driving != there or robot.path_status in (PathStatus.ARRIVED, PathStatus.IDLE) \
-                or getattr(self, "_command_id", None) != robot.command_id:
+        if not on_own_route or robot.path_status in (PathStatus.ARRIVED, PathStatus.IDLE):
             route = view.route(there)
             if route is None and inside:  # as near as it gets
                 self._driving, self._settled = None, there

@@ -112,7 +112,7 @@ class VoxelNetworkView:
             return None
         goal = np.asarray(pos) + [0.0, 0.0, self.sight_height_m()]
         plan, target = self._plan_towards(goal, force=False)
-        if target is None:
+        if target is None and self.navigator.map_changed():
             plan, target = self._plan_towards(goal, force=True)
         if plan is None:
             return None

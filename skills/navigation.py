@@ -73,6 +73,10 @@ class Navigator:
             self.builds += 1
         return self._graph
 
+    def map_changed(self) -> bool:
+        """Whether the map has changed since the graph was built (a forced rebuild would differ)."""
+        return self._graph_key is None or self._graph_key[0] != self.robot.onboard_map.version
+
     def node_near(self, graph: NavGraph, point: np.ndarray) -> int | None:
         """The graph node nearest to ``point`` within the snap radii, or None."""
         for r in self.snap_radii_m:

@@ -104,9 +104,11 @@ def extract_topology(
     _check_parameters(cell_m, comm_range_m, min_free_voxels, sight_height_m)
     corner = _checked_point(lattice_origin, "lattice_origin")
     visited_cells = _visited_cells(visited, cell_m, corner)
-    mask = _standable_mask(grid, standable)
-    passable_mask = mask if passable is None else _standable_mask(grid, passable, "passable")
-    grid, (mask, passable_mask) = _cropped(grid, [mask, passable_mask])
+    standable = _checked_mask(grid, standable, "standable")
+    passable = _checked_mask(grid, passable, "passable")
+    grid, box = _cropped(grid)
+    mask = _known_free(grid, standable, box)
+    passable_mask = mask if passable is None else _known_free(grid, passable, box)
     partition = _partition(grid, cell_m, corner)
     labels = _components_within_cells(mask | passable_mask, partition)
     topo = Topology()
@@ -230,24 +232,29 @@ def _visited_cells(visited: np.ndarray | None, cell_m: float,
     return {tuple(c) for c in lattice_cells(points, cell_m, corner).tolist()}
 
 
-def _standable_mask(grid: Grid, standable: np.ndarray | None, what: str = "standable") -> np.ndarray:
-    """Dense bool mask of the known-free voxels of ``standable`` (None: all of them)."""
-    mask = grid.occupancy == FREE
-    if standable is None:
-        return mask
-    st = np.asarray(standable)
-    if st.shape != grid.shape or st.dtype != bool:
-        raise ValueError(f"{what} must be a bool mask of shape {grid.shape}, got {st.dtype} {st.shape}")
-    return mask & st
+def _checked_mask(grid: Grid, mask: np.ndarray | None, what: str) -> np.ndarray | None:
+    if mask is None:
+        return None
+    m = np.asarray(mask)
+    if m.shape != grid.shape or m.dtype != bool:
+        raise ValueError(f"{what} must be a bool mask of shape {grid.shape}, got {m.dtype} {m.shape}")
+    return m
 
 
-def _cropped(grid: Grid, masks: list[np.ndarray]) -> tuple[Grid, list[np.ndarray]]:
-    """The grid and masks cut to the box of the known-free voxels and a margin deep
-    enough for the frontier test, so that the dense steps below scale with the
+def _known_free(grid: Grid, mask: np.ndarray | None, box: tuple[slice, ...]) -> np.ndarray:
+    """Dense bool mask of the known-free voxels of ``grid`` (already cut to ``box``)
+    that ``mask`` (full size, cut here; None: every one) holds."""
+    free = grid.occupancy == FREE
+    return free if mask is None else free & mask[box]
+
+
+def _cropped(grid: Grid) -> tuple[Grid, tuple[slice, ...]]:
+    """The grid cut to the box of the known-free voxels and a margin deep enough for
+    the frontier test, and the box, so that the dense steps below scale with the
     mapped part of the world, not the whole map."""
     free = grid.free_voxels()
     if len(free) == 0:
-        return grid, masks
+        return grid, tuple(slice(0, n) for n in grid.shape)
     ijk = np.unravel_index(free, grid.shape)
     margin = FRONTIER_DEPTH + 1
     lo = [max(0, int(a.min()) - margin) for a in ijk]
@@ -257,7 +264,7 @@ def _cropped(grid: Grid, masks: list[np.ndarray]) -> tuple[Grid, list[np.ndarray
     sub_free = np.ravel_multi_index(tuple(a - o for a, o in zip(ijk, lo)), shape)
     sub = Grid(grid.occupancy[box], grid.origin + np.array(lo) * grid.voxel_size_m, grid.voxel_size_m,
                np.sort(sub_free))
-    return sub, [m[box] for m in masks]
+    return sub, box
 
 
 # -- components and locations ------------------------------------------------------------
