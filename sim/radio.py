@@ -73,7 +73,7 @@ _MIN_SUCCESS = 1e-12
 
 @dataclass(frozen=True)
 class Message:
-    """A radio message (the robot interface's ``Message``)."""
+    """A radio message (implements the robot interface's ``Message`` protocol)."""
 
     sender: str
     recipient: str

@@ -10,7 +10,6 @@ Onboard maps use these voxel values: ``UNKNOWN = -1``, ``FREE = 0``, ``OCCUPIED 
 from __future__ import annotations
 
 import enum
-from dataclasses import dataclass
 from typing import Any, Protocol
 
 import numpy as np
@@ -62,15 +61,21 @@ class MapView(Protocol):
         """Flat voxel indices and values changed since the last call (for map sharing)."""
 
 
-@dataclass(frozen=True)
-class Message:
-    """A radio message: who sent it, to whom, what kind, and its payload."""
+class Message(Protocol):
+    """A radio message: who sent it, to whom, what kind, its payload and when (sim s).
 
-    sender: str
-    recipient: str
-    kind: str
-    data: Any
-    sent_s: float
+    A protocol, not a class: the radio that implements ``Radio`` makes them."""
+
+    @property
+    def sender(self) -> str: ...
+    @property
+    def recipient(self) -> str: ...
+    @property
+    def kind(self) -> str: ...
+    @property
+    def data(self) -> Any: ...
+    @property
+    def sent_s(self) -> float: ...
 
 
 class Radio(Protocol):

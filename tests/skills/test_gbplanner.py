@@ -25,7 +25,8 @@ from delve.skills.gbplanner import (
 )
 from py_trees.common import Status
 
-from .test_motion import FakeRobot, body, events, make_ctx, run
+from .fakes import FakeRobot, events, make_ctx, run
+from .test_motion import body
 
 SMALL = {"max_vertices": 150, "planner": {"num_edges_max": 2500}}
 

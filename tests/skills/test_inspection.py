@@ -2,7 +2,6 @@
 walks a synthetic tunnel map with the simulator's pan-tilt-zoom payload."""
 from __future__ import annotations
 
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -10,9 +9,9 @@ import py_trees
 import pytest
 from delve.executive.tree_loader import load_tree
 from delve.planners.gbplanner2 import synthetic as syn
-from delve.planners.occupancy import FREE, OCCUPIED, Grid
+from delve.planners.occupancy import OCCUPIED, Grid
 from delve.sim.payload import PanTiltZoomCamera
-from delve.skills.base import AgentContext, Skill
+from delve.skills.base import Skill
 from delve.skills.inspection import (
     SEEN_SERVICE,
     BodyCameras,
@@ -28,92 +27,19 @@ from delve.skills.inspection import (
 from delve.skills.robot import PathStatus
 from py_trees.common import Status
 
+from . import fakes
+from .fakes import FakeMap, make_ctx
+
 TREES = Path(__file__).resolve().parents[2] / "trees"
 #: Body cameras that see only a thin band about the horizon: most of the payload's
 #: workspace stays unseen, so a request calls for a full scan.
 NARROW = {"body_camera_vertical_fov_deg": 10.0}
 
 
-class Clock:
-    def __init__(self) -> None:
-        self.now_s = 0.0
-
-
-@dataclass
-class FakeMobility:
-    aerial: bool = False
-    speed_mps: float = 1.0
-    body_height_m: float = 0.5
-    radius_m: float = 0.4
-    max_inclination_deg: float = 35.0
-    max_step_m: float = 0.3
-
-
-class FakeMap:
-    def __init__(self, grid: Grid):
-        self.occupancy, self.origin, self.voxel_size_m, self.version = (grid.occupancy, grid.origin,
-                                                                         grid.voxel_size_m, 1)
-
-    def free_voxels(self) -> np.ndarray:
-        return np.flatnonzero(self.occupancy.reshape(-1) == FREE)
-
-
-class FakeRobot:
-    """Walks paths in straight lines at its speed when :meth:`step` is called, facing
-    the way it walks, and carries the simulator's payload (no world needed: the skill
-    works out occlusion on the onboard map)."""
-
-    def __init__(self, grid: Grid, position, payload: bool = True):
-        self.name = "r1"
-        self.platform = "legged"
-        self.mobility = FakeMobility()
-        self.onboard_map = FakeMap(grid)
-        self._pos = np.asarray(position, float)
-        self.yaw_rad = 0.0
-        self.path: np.ndarray | None = None
-        self.path_status = PathStatus.IDLE
-        self.command_id = 0
-        self.paths: list[np.ndarray] = []
-        self.payload = PanTiltZoomCamera(None, occlusion_tolerance_m=grid.voxel_size_m) if payload else None
-
-    @property
-    def position(self) -> np.ndarray:
-        return self._pos.copy()
-
-    @property
-    def remaining_path(self) -> np.ndarray:
-        if self.path_status != PathStatus.FOLLOWING or self.path is None:
-            return np.zeros((0, 3))
-        return self.path.copy()
-
-    def follow_path(self, path) -> None:
-        self.command_id += 1
-        self.path = np.asarray(path, float).reshape(-1, 3)
-        self.paths.append(self.path.copy())
-        self.path_status = PathStatus.FOLLOWING
-
-    def stop(self) -> None:
-        self.command_id += 1
-        self.path = None
-        if self.path_status == PathStatus.FOLLOWING:
-            self.path_status = PathStatus.IDLE
-
-    def step(self, dt_s: float) -> None:
-        if self.path_status != PathStatus.FOLLOWING or self.path is None:
-            return
-        budget = self.mobility.speed_mps * dt_s
-        while budget > 1e-9 and len(self.path):
-            delta = self.path[0] - self._pos
-            d = float(np.linalg.norm(delta))
-            if d > 1e-9:
-                self.yaw_rad = float(np.arctan2(delta[1], delta[0]))
-            move = min(budget, d)
-            self._pos = self._pos + delta * (move / d) if d > 1e-9 else self.path[0].copy()
-            budget -= move
-            if d - move < 1e-9:
-                self.path = self.path[1:]
-        if len(self.path) == 0:
-            self.path, self.path_status = None, PathStatus.ARRIVED
+def camera_robot(grid: Grid, position, payload: bool = True) -> fakes.FakeRobot:
+    """The fake robot carrying the simulator's pan-tilt-zoom camera (or nothing)."""
+    camera = PanTiltZoomCamera(None, occlusion_tolerance_m=grid.voxel_size_m) if payload else None
+    return fakes.FakeRobot(grid, position, payload=camera)
 
 
 class Walker(Skill):
@@ -138,14 +64,6 @@ class Walker(Skill):
         if new_status == Status.INVALID and self.following:
             self.robot.stop()
         self.following = False
-
-
-def make_ctx(robot) -> AgentContext:
-    events: list[tuple[str, dict]] = []
-    ctx = AgentContext(name="r1", namespace="/r1", clock=Clock(),
-                       log=lambda event, **fields: events.append((event, fields)), robot=robot)
-    ctx.events = events  # type: ignore[attr-defined]
-    return ctx
 
 
 def events(ctx, kind: str) -> list[dict]:
@@ -196,7 +114,7 @@ def straight_path(start, length_m: float, spacing_m: float = 2.0) -> np.ndarray:
 # ------------------------------------------------------------------------- geometry
 def test_surface_voxels_are_the_occupied_voxels_within_range(tunnel):
     grid, start, _ = tunnel
-    robot = FakeRobot(grid, body(start, 8))
+    robot = camera_robot(grid, body(start, 8))
     ijk, pts = surface_voxels(robot.onboard_map, robot.position, 5.0)
     assert len(pts) > 100
     assert np.all(np.linalg.norm(pts - robot.position, axis=1) <= 5.0)
@@ -240,7 +158,7 @@ def test_body_cameras_see_a_band_about_the_horizon():
 
 def test_walking_counts_what_the_body_cameras_saw_earlier(tunnel):
     grid, start, _ = tunnel
-    robot = FakeRobot(grid, body(start, 10))
+    robot = camera_robot(grid, body(start, 10))
     fresh = SeenRecord(np.zeros(grid.shape, bool))
     walked = SeenRecord(np.zeros(grid.shape, bool))
     for x in np.arange(2.0, 10.01, 1.0):             # the walk up to here, looking about
@@ -255,7 +173,7 @@ def test_walking_counts_what_the_body_cameras_saw_earlier(tunnel):
 
 def test_scan_points_cover_the_unseen_part_from_the_payloads_1170_candidates(tunnel):
     grid, start, _ = tunnel
-    robot = FakeRobot(grid, body(start, 8))
+    robot = camera_robot(grid, body(start, 8))
     record = SeenRecord(np.zeros(grid.shape, bool))
     record.look(robot, BodyCameras(vertical_fov_deg=10.0))
     plan = plan_inspection(robot, record)
@@ -272,7 +190,7 @@ def test_scan_points_cover_the_unseen_part_from_the_payloads_1170_candidates(tun
 # ------------------------------------------------------------------------- the skill
 def test_no_request_fails_and_keeps_recording_what_the_body_cameras_see(tunnel):
     grid, start, _ = tunnel
-    robot = FakeRobot(grid, body(start, 6))
+    robot = camera_robot(grid, body(start, 6))
     ctx = make_ctx(robot)
     node = Inspect("Inspect", ctx)
     assert step(node, ctx, robot) == Status.FAILURE
@@ -286,7 +204,7 @@ def test_no_request_fails_and_keeps_recording_what_the_body_cameras_see(tunnel):
 
 def test_full_scan_pauses_scans_every_point_and_resumes_the_same_path(tunnel):
     grid, start, _ = tunnel
-    robot = FakeRobot(grid, body(start, 4))
+    robot = camera_robot(grid, body(start, 4))
     path = straight_path(robot.position, 12.0)
     robot.follow_path(path)
     for _ in range(5):
@@ -336,7 +254,7 @@ def test_full_scan_pauses_scans_every_point_and_resumes_the_same_path(tunnel):
 
 def test_point_scan_scans_while_the_robot_walks_on(tunnel):
     grid, start, _ = tunnel
-    robot = FakeRobot(grid, body(start, 2))
+    robot = camera_robot(grid, body(start, 2))
     ctx = make_ctx(robot)
     node = Inspect("Inspect", ctx, dwell_s=0.3, resume_until_path_end=False)
     path = straight_path(robot.position, 16.0)
@@ -366,7 +284,7 @@ def test_inspections_put_the_block_below_on_hold_and_survive_its_stop(tunnel):
     it is halted, as Explore does) is interrupted; a point scan keeps walking its path,
     and once the inspection is done the block below runs again."""
     grid, start, _ = tunnel
-    robot = FakeRobot(grid, body(start, 2))
+    robot = camera_robot(grid, body(start, 2))
     ctx = make_ctx(robot)
     inspect = Inspect("Inspect", ctx, dwell_s=0.3, resume_until_path_end=False)
     walker = Walker("Walk", ctx, straight_path(robot.position, 18.0))
@@ -391,7 +309,7 @@ def test_inspections_put_the_block_below_on_hold_and_survive_its_stop(tunnel):
 
 def test_a_point_out_of_reach_fails_when_approaching_is_off(tunnel):
     grid, start, _ = tunnel
-    robot = FakeRobot(grid, body(start, 2))
+    robot = camera_robot(grid, body(start, 2))
     ctx = make_ctx(robot)
     node = Inspect("Inspect", ctx, approach_point=False)
     request(ctx, point=[start[0] + 15.0, start[1], 3.9])
@@ -405,7 +323,7 @@ def test_a_point_out_of_reach_fails_when_approaching_is_off(tunnel):
 
 def test_a_point_in_reach_is_inspected_around_it(tunnel):
     grid, start, _ = tunnel
-    robot = FakeRobot(grid, body(start, 4))
+    robot = camera_robot(grid, body(start, 4))
     ctx = make_ctx(robot)
     node = Inspect("Inspect", ctx, dwell_s=0.2)
     point = [start[0] + 6.5, start[1], 3.9]            # the roof, 2.5 m ahead
@@ -427,7 +345,7 @@ def test_a_point_in_reach_is_inspected_around_it(tunnel):
 ])
 def test_impossible_requests_fail_with_a_reason(tunnel, point, payload, reason):
     grid, start, _ = tunnel
-    robot = FakeRobot(grid, body(start, 4), payload=payload)
+    robot = camera_robot(grid, body(start, 4), payload=payload)
     ctx = make_ctx(robot)
     node = Inspect("Inspect", ctx)
     request(ctx, point=point)
@@ -438,7 +356,7 @@ def test_impossible_requests_fail_with_a_reason(tunnel, point, payload, reason):
 
 def test_a_newer_request_is_kept_for_the_next_run(tunnel):
     grid, start, _ = tunnel
-    robot = FakeRobot(grid, body(start, 4))
+    robot = camera_robot(grid, body(start, 4))
     ctx = make_ctx(robot)
     node = Inspect("Inspect", ctx, dwell_s=0.2, **NARROW)
     request(ctx)
@@ -456,7 +374,7 @@ def test_a_newer_request_is_kept_for_the_next_run(tunnel):
 
 def test_the_inspections_subtree_is_idle_without_a_request(tunnel):
     grid, start, _ = tunnel
-    robot = FakeRobot(grid, body(start, 4))
+    robot = camera_robot(grid, body(start, 4))
     ctx = make_ctx(robot)
     root = load_tree(TREES / "subtrees" / "inspections.yaml", ctx)
     root.tick_once()
@@ -469,7 +387,7 @@ def test_the_inspections_subtree_is_idle_without_a_request(tunnel):
 
 def test_a_point_out_of_reach_is_walked_to_then_the_same_path_resumed(tunnel):
     grid, start, _ = tunnel
-    robot = FakeRobot(grid, body(start, 2))
+    robot = camera_robot(grid, body(start, 2))
     path = straight_path(robot.position, 6.0)
     robot.follow_path(path)
     robot.step(1.0)
