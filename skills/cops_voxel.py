@@ -93,13 +93,28 @@ class VoxelNetworkView:
         return self.current().to_dict()
 
     def location(self) -> str | None:
-        """The location whose cell holds the robot's ground point, or None."""
-        name = self.cell_of(self.ground_point()[None])[0]
-        return name if name in self.current().locations else None
+        """The location the robot has arrived at (the nearest whose :meth:`target` is
+        within ``ARRIVAL_RADIUS_M``), else the one whose cell holds its ground point,
+        else None. Arrival comes first because the body stands on the true ground and
+        positions lie on map voxels: at a location's position on a slope, the ground
+        point can fall into the cell below when a floor crosses a cell's boundary."""
+        locations = self.current().locations
+        ground = self.ground_point()
+        if locations:
+            names = list(locations)
+            home_cell, home = self._home()
+            targets = np.array([home if n == home_cell else locations[n] for n in names], dtype=float)
+            gaps = np.linalg.norm(targets - ground, axis=1)
+            i = int(np.argmin(gaps))
+            if gaps[i] <= ARRIVAL_RADIUS_M:
+                return names[i]
+        name = self.cell_of(ground[None])[0]
+        return name if name in locations else None
 
     def arrived(self, location: str) -> bool:
-        """Whether the robot's ground point is within ``ARRIVAL_RADIUS_M`` of the location's position."""
-        pos = self.current().locations.get(location)
+        """Whether the robot's ground point is within ``ARRIVAL_RADIUS_M`` of where it
+        goes for the location (:meth:`target`)."""
+        pos = self.target(location)
         return pos is not None and float(np.linalg.norm(self.ground_point() - pos)) <= ARRIVAL_RADIUS_M
 
     def route(self, location: str) -> np.ndarray | None:
@@ -107,10 +122,10 @@ class VoxelNetworkView:
         the location's position or, when the graph does not reach it yet, to the
         reachable node nearest it (if that is ``MIN_PROGRESS_M`` nearer than the robot);
         None for an unknown location or when no such node is reachable."""
-        pos = self.current().locations.get(location)
+        pos = self.target(location)
         if pos is None:
             return None
-        goal = np.asarray(pos) + [0.0, 0.0, self.sight_height_m()]
+        goal = pos + [0.0, 0.0, self.sight_height_m()]
         plan, target = self._plan_towards(goal, force=False)
         if target is None and self.navigator.map_changed():
             plan, target = self._plan_towards(goal, force=True)
@@ -132,6 +147,21 @@ class VoxelNetworkView:
             return None, None
         target = self.navigator.node_near(plan.graph, goal)
         return plan, target if target is not None and np.isfinite(plan.distances[target]) else None
+
+    def target(self, location: str) -> np.ndarray | None:
+        """The ground point the robot goes to for a location: the location's position
+        or, in the cell of the robot's home, its home (so each robot of a team comes
+        back to its own start pose); None for an unknown location."""
+        pos = self.current().locations.get(location)
+        if pos is None:
+            return None
+        home_cell, home = self._home()
+        return home if location == home_cell else np.asarray(pos, dtype=float)
+
+    def _home(self) -> tuple[str, np.ndarray]:
+        """The cell of the robot's home and the home's ground point."""
+        home = self.ground_points(np.asarray(self.robot.home, dtype=float)[None])[0]
+        return self.cell_of(home[None])[0], home
 
     def cell_of(self, points: np.ndarray) -> list[str]:
         """The names of the lattice cells of ground points (N, 3)."""

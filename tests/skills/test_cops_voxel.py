@@ -70,13 +70,22 @@ def test_location_is_the_robots_cell(scanned):
 
 def test_route_to_a_neighbouring_location(scanned):
     robot, view = scanned
-    goal = np.array(view.current().locations["c0_0_0"])
+    goal = view.target("c0_0_0")             # the robot's home: c0_0_0 holds it
     path = view.route("c0_0_0")
     assert path is not None and path.shape[1] == 3
     assert np.linalg.norm(path[0] - robot.position) < 1.0
     assert np.linalg.norm(path[-1][:2] - goal[:2]) < 0.5
     assert path[-1][2] == pytest.approx(goal[2] + LEGGED.body_height_m - 0.5 * V)
     assert view.route("c9_9_9") is None
+
+
+def test_a_robot_goes_home_to_its_own_start_in_the_home_cell(scanned):
+    robot, view = scanned
+    home = view.ground_points(robot.home[None])[0]
+    assert view.target("c0_0_0") == pytest.approx(home)
+    assert view.target("c1_0_0") == pytest.approx(view.current().locations["c1_0_0"])
+    assert view.target("c9_9_9") is None
+    assert not view.arrived("c0_0_0")
 
 
 def test_extraction_is_cached_per_map_version(tunnel):
@@ -97,7 +106,7 @@ def test_aerial_robot_flies_through_its_cells(tunnel):
     topo = view.current()
     assert view.location() == "c1_0_0" and ("c0_0_0", "c1_0_0") in topo.mobility
     path = view.route("c0_0_0")
-    assert path is not None and np.linalg.norm(path[-1] - topo.locations["c0_0_0"]) < 1.0
+    assert path is not None and np.linalg.norm(path[-1] - view.target("c0_0_0")) < 1.0
 
 
 def test_bad_cell_size_is_refused(tunnel):
@@ -145,3 +154,15 @@ def test_the_revision_moves_with_extractions_and_visits(tunnel):
     assert view.revision == first
     walk(robot, 10.0)
     assert view.revision != first and "c1_0_0" in view.current().explored
+
+
+def test_a_robot_at_a_locations_position_is_there_whatever_cell_its_ground_point_is_in(tunnel):
+    """A floor crossing a cell boundary can put the ground point of a robot standing
+    at a location's position into the cell below: arrival decides."""
+    robot = robot_in(tunnel)
+    walk(robot, 7.0)                           # in c0_0_0, near its boundary with c1_0_0
+    view = VoxelNetworkView(robot)
+    assert view.location() == "c0_0_0"
+    topo = view.current()
+    topo.locations["c1_0_0"] = tuple(view.ground_point() + [1.0, 0.0, -0.3])
+    assert view.arrived("c1_0_0") and view.location() == "c1_0_0"
