@@ -5,7 +5,8 @@ planning and ticking.
 
 Prints the median over the runs. The shares come from timing the functions that do
 each kind of work (wrapped here, in the benchmark only); "planning" is the time in
-the navigation-graph and frontier planners, "ticking" is tree ticks minus planning.
+the navigation-graph and frontier planners and the COPS network extraction (voxel
+worlds), "ticking" is tree ticks minus planning.
 """
 from __future__ import annotations
 
@@ -23,7 +24,7 @@ from delve.planners import frontier, navgraph
 from delve.sim import robot as robot_mod
 from delve.sim.voxel_map import VoxelMap
 from delve.sim.world import World
-from delve.skills import exploration, navigation
+from delve.skills import cops_voxel, exploration, navigation
 
 SPENT: dict[str, float] = defaultdict(float)
 
@@ -52,6 +53,7 @@ def instrument() -> None:
         timed(mod, "frontier_voxels", "planning")
         timed(mod, "frontier_clusters", "planning")
         timed(mod, "nearest_frontier", "planning")
+    timed(cops_voxel, "extract_topology", "planning")
     timed(agent_mod.Agent, "tick_if_due", "ticking (incl. planning)")
     timed(robot_mod.SimRobot, "step", "kinematics")
 

@@ -131,7 +131,7 @@ def extract_topology(
     explored |= [tuple(c) in visited_cells for c in lattice.tolist()]
     for name, pos, done in zip(names, positions, explored):
         topo.add_location(name, pos, explored=bool(done))
-    mobility = _mobility_pairs(_touching_components(labels), location_of)
+    mobility = _mobility_pairs(_touching_components(labels, partition), location_of)
     lengths = np.linalg.norm(positions[mobility[:, 0]] - positions[mobility[:, 1]], axis=1)
     for (a, b), length in zip(mobility.tolist(), lengths.tolist()):
         topo.add_mobility_edge(names[a], names[b], length)
@@ -280,7 +280,9 @@ def _components_within_cells(mask: np.ndarray, partition: list[np.ndarray]) -> n
         layers = np.arange(len(cells))
         kept.append(layers + np.searchsorted(bounds, layers, side="right"))
     labels, _ = ndimage.label(cut, structure=_CONNECTIVITY_26)
-    return labels[np.ix_(*kept)]
+    for axis, layers in enumerate(kept):  # one axis at a time: faster than np.ix_
+        labels = labels.take(layers, axis=axis)
+    return labels
 
 
 def _locations(component: np.ndarray, cell_key: np.ndarray, stands: np.ndarray,
@@ -321,16 +323,29 @@ def _frontier_cell_keys(grid: Grid, partition: list[np.ndarray]) -> np.ndarray:
 
 
 # -- edges ----------------------------------------------------------------------------------
-def _touching_components(labels: np.ndarray) -> np.ndarray:
-    """(E, 2) sorted pairs of distinct components (0-based) with 26-neighbouring voxels."""
+def _touching_components(labels: np.ndarray, partition: list[np.ndarray]) -> np.ndarray:
+    """(E, 2) sorted pairs of distinct components (0-based) with 26-neighbouring voxels.
+
+    Components lie within cells and two components of one cell never touch, so only
+    neighbours across a cell boundary are compared: per offset and per axis it
+    moves along, the layers on either side of that axis's boundaries."""
     out = []
     for d in _HALF_NEIGHBOURS_26:
         src = tuple(slice(max(0, -o), n - max(0, o)) for o, n in zip(d, labels.shape))
         dst = tuple(slice(max(0, o), n - max(0, -o)) for o, n in zip(d, labels.shape))
-        a, b = labels[src], labels[dst]
-        hit = (a != b) & (a > 0) & (b > 0)
-        out.append(np.stack([a[hit], b[hit]], axis=1))
-    pairs = np.sort(np.concatenate(out).astype(np.int64) - 1, axis=1)
+        for axis, o in enumerate(d):
+            if o == 0:
+                continue
+            cells = partition[axis]
+            first = src[axis].start
+            layer = np.arange(first, src[axis].stop)
+            near, far = labels[src], labels[dst]
+            for i in np.flatnonzero(cells[layer] != cells[layer + o]).tolist():
+                at = (slice(None),) * axis + (i,)
+                a, b = near[at], far[at]
+                hit = (a != b) & (a > 0) & (b > 0)
+                out.append(np.stack([a[hit], b[hit]], axis=1))
+    pairs = np.sort(np.concatenate(out).astype(np.int64) - 1, axis=1) if out else np.zeros((0, 2), np.int64)
     n = int(labels.max())
     keys = np.unique(pairs[:, 0] * n + pairs[:, 1])
     return np.stack([keys // n, keys % n], axis=1)
