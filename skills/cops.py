@@ -55,7 +55,9 @@ class Knowledge:
     declared lost after it was last heard from.
     ``map_chunks``: on voxel worlds, the pieces of robots' onboard maps this agent
     holds ("r1/4" -> (flat indices, values)), carried like the rest of the
-    information until they reach the base station's map."""
+    information until they reach the base station's map.
+    ``finished[r]``: the final plan's cycle, for a robot that got it at the base with
+    its part done (its communications in that plan count as done)."""
 
     topology: Topology = field(default_factory=Topology)
     freshness: dict[str, int] = field(default_factory=dict)
@@ -65,6 +67,7 @@ class Knowledge:
     heard: dict[str, float] = field(default_factory=dict)
     pending_plan: dict[str, Any] | None = None
     map_chunks: dict[str, tuple[Any, Any]] = field(default_factory=dict)
+    finished: dict[str, int] = field(default_factory=dict)
 
     @property
     def lost(self) -> set[str]:
@@ -72,7 +75,8 @@ class Knowledge:
 
     def payload(self) -> dict[str, Any]:
         return {"topology": self.topology.to_dict(), "freshness": dict(self.freshness),
-                "declared": dict(self.declared), "heard": dict(self.heard), "map": dict(self.map_chunks)}
+                "declared": dict(self.declared), "heard": dict(self.heard), "map": dict(self.map_chunks),
+                "finished": dict(self.finished)}
 
     def collect_map(self, robot: str, onboard_map: Any) -> None:
         """Add what ``robot``'s onboard map gained since the last call as a chunk."""
@@ -85,7 +89,7 @@ class Knowledge:
             self.map_chunks.setdefault(key, chunk)
         self.topology.merge(Topology.from_dict(payload["topology"]))
         for mine, theirs in ((self.freshness, payload["freshness"]), (self.declared, payload["declared"]),
-                             (self.heard, payload["heard"])):
+                             (self.heard, payload["heard"]), (self.finished, payload.get("finished", {}))):
             for r, v in theirs.items():
                 mine[r] = max(mine.get(r, -math.inf), v)
 
@@ -273,11 +277,19 @@ class InformationStorage(CopsSkill):
         return Status.RUNNING
 
     def _hand_final_plan(self, robot: str, st: CopsState) -> None:
-        """A robot back at the base that the final plan m never reached gets it there,
-        with its part done: the mission is over for it."""
+        """A robot greeting the leader from the base gets the final plan m there. When
+        the plan has it at the base at the leader's step, it joins in there (it may
+        still have to carry m out, or hand over what it holds); else (the plan
+        believed it elsewhere) its part is done, the mission is over for it, and the
+        team counts their communications with it as done (``finished``)."""
+        plan = st.part_plan()
+        joins = plan is not None and robot in plan.robots and plan.location(robot, st.step) == st.base_location
+        part, step = (st.part, st.step) if joins else ("done", 0)
+        if not joins:
+            st.knowledge.finished[robot] = st.cycle
         payload = {**st.knowledge.payload(), "plan": st.plan_message()}
         self.radio.send(robot, KIND, {"type": "info", "id": final_plan_id(st.cycle, robot), "cycle": st.cycle,
-                                      "part": "done", "t": 0, "info": MASTER, "payload": payload})
+                                      "part": part, "t": step, "info": MASTER, "payload": payload})
 
     def _sense(self, st: CopsState) -> None:
         view = network_view(self.ctx)
@@ -328,8 +340,10 @@ class SolveCOPS(CopsSkill):
     whose earlier information never reached the base are added to the
     post-exploration sources. With no frontier left, the plan is the recall: m
     reaches every robot and brings it to the base, where those sources hand over
-    what the base lacks. Every plan is checked with the
-    plan validator before it is used.
+    what the base lacks. Robots coming back by the standing order of m are planned
+    static at the base; so are, in a recall, robots that order will have sent home
+    before the recall's m reaches them (logged ``cops_replan_returning``). Every
+    plan is checked with the plan validator before it is used.
 
     Reads services ``team`` (robot -> start location) and ``base_location``.
     Writes ``cops`` (plan, cycle, part = pre, step = 0). Logs ``cops_plan``.
@@ -358,15 +372,13 @@ class SolveCOPS(CopsSkill):
         kn = st.knowledge
         positions, returning = self._positions(st, team)
         try:
-            net = team_network(kn.topology, base_loc, self.ctx.name, positions, spacing_m=self.p["spacing_m"])
-            positions = net.positions()
-            opts = SolverOptions(time_limit_s=self.p["time_limit_s"])
-            frontiers = net.frontiers
-            owed = {r for r in positions if st.explored_in.get(r, -1) > kn.freshness.get(r, -1)}
-            if frontiers:
-                cyc = self._cycle(net, positions, owed, opts)
-            else:
-                cyc = self._recall(net, positions, owed, opts)
+            net, cyc = self._plan(st, positions, returning)
+            gone = set() if net.frontiers or cyc.meta["owed"] else self._gone_before_m(st, cyc)
+            if gone:  # plan them at the base, where the standing order of m brings them
+                self.event("cops_replan_returning", cycle=st.cycle + 1, robots=sorted(gone))
+                returning = sorted(set(returning) | gone)
+                net, cyc = self._plan(st, {r: base_loc if r in gone else s for r, s in positions.items()}, returning)
+            positions, frontiers, owed = net.positions(), net.frontiers, cyc.meta["owed"]
             if frontiers and not cyc.exploration and not owed:
                 raise PlanningError(f"{len(frontiers)} frontiers left but no robot that m can reach is "
                                     f"sent to one (robots out of radio reach of the base and of each other)")
@@ -412,11 +424,57 @@ class SolveCOPS(CopsSkill):
         unreachable = _unreachable(st.knowledge.topology, st.base_location, pos)
         return {r: st.base_location if r in unreachable else s for r, s in pos.items()}, sorted(unreachable)
 
-    def _cycle(self, net, positions: dict[str, str], owed: set[str], opts: SolverOptions) -> CyclePlan:
+    def _plan(self, st: CopsState, positions: dict[str, str], returning: list[str]) -> tuple[Any, CyclePlan]:
+        """The network N of what the base knows with the team at ``positions``, and the
+        next cycle on it: a cycle with frontiers left, else the recall. Robots
+        ``returning`` by the standing order reach the base at a time nobody knows:
+        they are planned static there (they get m when they arrive), unless no other
+        robot is left to explore."""
+        kn = st.knowledge
+        net = team_network(kn.topology, st.base_location, self.ctx.name, positions, spacing_m=self.p["spacing_m"])
+        positions = net.positions()
+        opts = SolverOptions(time_limit_s=self.p["time_limit_s"])
+        owed = {r for r in positions if st.explored_in.get(r, -1) > kn.freshness.get(r, -1)}
+        plan = self._cycle if net.frontiers else self._recall
+        static = {self.ctx.name, *returning}
+        if net.frontiers and not set(positions) - static:
+            static = {self.ctx.name}
+        cyc = plan(net, positions, owed, static, opts)
+        cyc.meta["owed"] = sorted(owed)
+        return net, cyc
+
+    def _gone_before_m(self, st: CopsState, cyc: CyclePlan) -> set[str]:
+        """Robots away from the base whose standing order of m will have sent them home
+        before the recall's m reaches them (asked only of a recall that may be the
+        last plan: a robot taken for gone too early comes home by that order anyway,
+        and the last plan hands it m there): the last plan's part ended
+        ``recall_after_s`` earlier (at the earliest: every step ΔT long), m reaches
+        them at step t of the new plan (at the earliest: t ΔT from now)."""
+        last = st.plan
+        if last is None:
+            return set()
+        now, base = self.ctx.clock.now_s, st.base_location
+        reaches: dict[str, int] = {r: 0 for r in cyc.pre.masters}
+        for c in sorted(cyc.pre.communications):
+            if c.info == MASTER:
+                reaches.setdefault(c.receiver, c.t)
+        gone = set()
+        for r, t in reaches.items():
+            if r == self.ctx.name or cyc.pre.location(r, 0) == base or r not in last.pre.robots:
+                continue
+            task = last.exploration.get(r)
+            steps = last.pre.horizon + last.post.horizon + (task.steps if task else 0)
+            standing_order_s = st.planned_s + steps * st.delta_t_s + st.recall_after_s
+            if now + t * self.p["delta_t_s"] >= standing_order_s:
+                gone.add(r)
+        return gone
+
+    def _cycle(self, net, positions: dict[str, str], owed: set[str], static: set[str],
+               opts: SolverOptions) -> CyclePlan:
         """Pre-exploration, exploration and post-exploration; robots whose earlier
         information the base lacks (``owed``) are post-exploration sources too."""
         me = self.ctx.name
-        kw = dict(masters={me}, explorers=set(positions) - {me}, static={me},
+        kw = dict(masters={me}, explorers=set(positions) - static, static=static,
                   min_exploration_steps=self.p["min_exploration_steps"], options=opts)
         try:
             cyc = plan_cycle(net, **kw)
@@ -428,23 +486,24 @@ class SolveCOPS(CopsSkill):
         if owed - set(cyc.pre.explore):
             post = solve_post_exploration(net, sources=sorted(set(cyc.pre.explore) | owed),
                                           positions=cyc.pre.final_positions(),
-                                          masters=sorted(cyc.pre.master_receivers()), static={me}, options=opts)
-            cyc = CyclePlan(cyc.pre, post, cyc.exploration, {**cyc.meta, "owed": sorted(owed)})
+                                          masters=sorted(cyc.pre.master_receivers()), static=static, options=opts)
+            cyc = CyclePlan(cyc.pre, post, cyc.exploration, dict(cyc.meta))
         return cyc
 
-    def _recall(self, net, positions: dict[str, str], owed: set[str], opts: SolverOptions) -> CyclePlan:
+    def _recall(self, net, positions: dict[str, str], owed: set[str], static: set[str],
+                opts: SolverOptions) -> CyclePlan:
         """No frontier left: the recall brings home every robot m reaches, then the
         robots whose information the base lacks (``owed``) hand it over there. The
         information may hold new frontiers, so that recall is not the last plan."""
         me = self.ctx.name
-        pre = solve_recall(net, positions=positions, masters={me}, static={me}, options=opts)
+        pre = solve_recall(net, positions=positions, masters={me}, static=static, options=opts)
         home, holders = pre.final_positions(), pre.master_receivers()
         sources = sorted(owed & holders)
-        post = solve_post_exploration(net, sources=sources, positions=home, masters=sorted(holders), static={me},
-                                      options=opts) if sources else idle_plan(home, holders, "post")
+        post = solve_post_exploration(net, sources=sources, positions=home, masters=sorted(holders),
+                                      static=static, options=opts) if sources else idle_plan(home, holders, "post")
         solve_s = sum(p.meta.get("solve_time_s") or 0.0 for p in (pre, post))
         return CyclePlan(pre, post, {}, {"solve_time_s": round(solve_s, 4), "recall": True,
-                                         "stranded": pre.meta["stranded"], "owed": sorted(owed)})
+                                         "stranded": pre.meta["stranded"]})
 
 
 def _unreachable(topology: Topology, base: str, positions: dict[str, str]) -> set[str]:
@@ -690,7 +749,9 @@ class CommunicationAction(CopsSkill):
     def _done(self, c: Communication, st: CopsState) -> bool:
         kn = st.knowledge
         mid = message_id(st.cycle, st.part, c)
-        return self._partner(c) in kn.lost or (mid in kn.acked if c.sender == self.ctx.name else mid in kn.received)
+        other = self._partner(c)
+        return other in kn.lost or kn.finished.get(other) == st.cycle or (
+            mid in kn.acked if c.sender == self.ctx.name else mid in kn.received)
 
     def _send(self, c: Communication, st: CopsState, now: float) -> None:
         mid = message_id(st.cycle, st.part, c)

@@ -10,7 +10,7 @@ from delve.planners.cops.plan import Communication, CyclePlan, ExplorationTask, 
 from delve.planners.cops.topology import Topology
 from delve.skills.base import AgentContext
 from delve.skills.cops import (CommunicationAction, ExplorationAction, InformationStorage, Knowledge,
-                               MissionComplete, TransitionAction, message_id)
+                               MissionComplete, SolveCOPS, TransitionAction, message_id)
 from py_trees.common import Status
 
 
@@ -225,6 +225,40 @@ def test_the_leader_waits_for_every_robot_home_and_hands_it_the_final_plan():
     assert done.status == Status.SUCCESS
 
 
+def greet(radio, storage, robot: str) -> dict:
+    radio.inbox.append(SimpleNamespace(sender=robot, kind="cops", data={"type": "hello", "home": True}))
+    storage.tick_once()
+    return radio.infos()[-1]
+
+
+def test_a_robot_greeting_from_the_base_joins_the_final_plan_where_the_plan_has_it_there():
+    """r1 is at the base at the leader's step 1 and carries m out at step 2: it joins
+    in at step 1. r2, which the plan has at s2, has its part done and counts as finished."""
+    radio = Radio()
+    ctx, storage, done, st = final_state("base", {"radio": radio, "team": {"r1": "s0", "r2": "s2"}})
+    pre = Plan(horizon=3, trajectories={"base": ["s0"] * 4, "r1": ["s0", "s0", "s1", "s2"],
+                                        "r2": ["s2"] * 4},
+               communications=[Communication(0, "base", "r1", "m"), Communication(3, "r1", "r2", "m")],
+               masters=["base"], phase="recall")
+    st.plan, st.part, st.step, st.base_location = CyclePlan(pre, pre, {}), "pre", 1, "s0"
+    reply = greet(radio, storage, "r1")
+    assert (reply["part"], reply["t"]) == ("pre", 1) and "r1" not in st.knowledge.finished
+    reply = greet(radio, storage, "r2")
+    assert reply["part"] == "done" and st.knowledge.finished == {"r2": 6}
+    assert Knowledge().payload().keys() == st.knowledge.payload().keys()
+    other = Knowledge()
+    other.absorb(st.knowledge.payload())
+    assert other.finished == {"r2": 6}  # it travels with the information
+
+
+def test_a_communication_with_a_finished_robot_is_done(relay):
+    """r4 got the final plan at the base with its part done: r3 does not wait for it."""
+    relay.st.knowledge.finished["r4"] = relay.st.cycle
+    relay.action.tick_once()
+    assert [d["info"] for d in relay.radio.infos()] == ["r2"]  # sends what it holds of r2's; gets nothing from r4
+    assert relay.action.status == Status.RUNNING  # its own message to the base is still unacknowledged
+
+
 def test_the_leader_declares_a_robot_never_heard_again_lost():
     ctx, storage, done, st = final_state("base", {"radio": Radio(), "team": {"r1": "s0"}})
     ctx.clock.now_s = 50.0 + st.recall_after_s + st.lost_timeout_s + 1.0
@@ -272,3 +306,28 @@ def test_map_chunks_travel_with_the_knowledge_and_are_never_taken_twice():
     assert sorted(base.map_chunks) == sorted(robot.map_chunks) and len(base.map_chunks) == 2
     merged = np.concatenate([flat for flat, _ in base.map_chunks.values()])
     assert sorted(merged.tolist()) == [1, 2, 3]
+
+
+def test_the_leader_counts_robots_whose_standing_order_fires_before_the_recall_reaches_them():
+    """The last plan (made at t = 0, 2 + 1 steps of 60 s) left r1 and r2 away; their
+    standing order fires at 3 * 60 + 1800 s. The recall reaches r1 at step 2 and r2 at
+    step 30: from t = 1500 s, r2 will have left by then, r1 not."""
+    py_trees.blackboard.Blackboard.clear()
+    ctx = AgentContext(name="base", namespace="/base", clock=SimpleNamespace(now_s=1500.0),
+                       log=lambda *a, **k: None, services={})
+    solve = SolveCOPS("COPS", ctx, delta_t_s=60.0)
+    st = solve.state
+    away = {"base": ["s0"] * 3, "r1": ["s0", "s1", "s1"], "r2": ["s0", "s1", "s2"], "r3": ["s0"] * 3}
+    last = Plan(horizon=2, trajectories=away, masters=["base"], phase="pre")
+    st.plan = CyclePlan(last, Plan(horizon=1, trajectories={r: t[-1:] * 2 for r, t in away.items()},
+                                   masters=["base"], phase="post"), {})
+    st.planned_s, st.delta_t_s, st.recall_after_s, st.base_location = 0.0, 60.0, 1800.0, "s0"
+    recall = Plan(horizon=30, trajectories={"base": ["s0"] * 31, "r1": ["s1"] * 31, "r2": ["s2"] * 31,
+                                            "r3": ["s0"] * 31},
+                  communications=[Communication(2, "base", "r1", "m"), Communication(30, "r1", "r2", "m"),
+                                  Communication(0, "base", "r3", "m")],
+                  masters=["base"], phase="recall")
+    assert solve._gone_before_m(st, CyclePlan(recall, recall, {})) == {"r2"}
+    ctx.clock.now_s = 100.0
+    assert solve._gone_before_m(st, CyclePlan(recall, recall, {})) == set()
+    py_trees.blackboard.Blackboard.clear()
