@@ -333,13 +333,12 @@ def _touching_components(labels: np.ndarray, partition: list[np.ndarray]) -> np.
     for d in _HALF_NEIGHBOURS_26:
         src = tuple(slice(max(0, -o), n - max(0, o)) for o, n in zip(d, labels.shape))
         dst = tuple(slice(max(0, o), n - max(0, -o)) for o, n in zip(d, labels.shape))
+        near, far = labels[src], labels[dst]
         for axis, o in enumerate(d):
             if o == 0:
                 continue
             cells = partition[axis]
-            first = src[axis].start
-            layer = np.arange(first, src[axis].stop)
-            near, far = labels[src], labels[dst]
+            layer = np.arange(src[axis].start, src[axis].stop)
             for i in np.flatnonzero(cells[layer] != cells[layer + o]).tolist():
                 at = (slice(None),) * axis + (i,)
                 a, b = near[at], far[at]

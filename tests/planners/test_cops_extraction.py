@@ -5,6 +5,7 @@ from __future__ import annotations
 import networkx as nx
 import numpy as np
 import pytest
+from delve.planners.cops import extraction
 from delve.planners.cops.extraction import cell_name, extract_topology, lattice_cells, line_of_sight
 from delve.planners.cops.topology import Topology
 from delve.planners.occupancy import FREE, OCCUPIED, UNKNOWN, Grid
@@ -213,3 +214,19 @@ def test_free_space_joins_floor_seen_in_rings():
     for pos in joined.locations.values():     # positions stay on the seen floor
         i, j, k = (np.asarray(pos) / V).astype(int)
         assert rings[i, j, k]
+
+
+def test_touching_components_are_found_across_cell_boundaries_as_by_comparing_every_neighbour():
+    rng = np.random.default_rng(7)
+    mask = rng.random((23, 17, 9)) < 0.5
+    partition = [np.arange(n) // 4 for n in mask.shape]  # cells of 4 voxels a side
+    labels = extraction._components_within_cells(mask, partition)
+    found = {tuple(p) for p in extraction._touching_components(labels, partition).tolist()}
+    every = set()
+    for d in extraction._HALF_NEIGHBOURS_26:
+        src = tuple(slice(max(0, -o), n - max(0, o)) for o, n in zip(d, labels.shape))
+        dst = tuple(slice(max(0, o), n - max(0, -o)) for o, n in zip(d, labels.shape))
+        a, b = labels[src], labels[dst]
+        hit = (a != b) & (a > 0) & (b > 0)
+        every |= {(min(x, y) - 1, max(x, y) - 1) for x, y in zip(a[hit].tolist(), b[hit].tolist())}
+    assert found == every and len(every) > 50
