@@ -331,3 +331,26 @@ def test_the_leader_counts_robots_whose_standing_order_fires_before_the_recall_r
     ctx.clock.now_s = 100.0
     assert solve._gone_before_m(st, CyclePlan(recall, recall, {})) == set()
     py_trees.blackboard.Blackboard.clear()
+
+
+def test_robots_coming_back_by_the_standing_order_are_planned_static_at_the_base():
+    """s0 (base) - s1 - s2 explored, s3 beyond s2. r1 comes back by the standing order:
+    it waits at the base in the plan and r2 explores; alone, r1 is sent out after all."""
+    py_trees.blackboard.Blackboard.clear()
+    ctx = AgentContext(name="base", namespace="/base", clock=SimpleNamespace(now_s=0.0),
+                       log=lambda *a, **k: None, services={})
+    solve = SolveCOPS("COPS", ctx, time_limit_s=5.0)
+    st = solve.state
+    st.base_location = "s0"
+    for i in range(4):
+        st.knowledge.topology.add_location(f"s{i}", (50.0 * i, 0.0, 0.0), explored=i < 3)
+    for i in range(3):
+        st.knowledge.topology.add_mobility_edge(f"s{i}", f"s{i + 1}", 50.0)
+        st.knowledge.topology.add_communication_edge(f"s{i}", f"s{i + 1}")
+    _, cyc = solve._plan(st, {"base": "s0", "r1": "s0", "r2": "s0"}, [])
+    assert set(cyc.exploration) == {"r1", "r2"}  # not coming back: both explore
+    _, cyc = solve._plan(st, {"base": "s0", "r1": "s0", "r2": "s0"}, ["r1"])
+    assert set(cyc.exploration) == {"r2"} and set(cyc.pre.trajectories["r1"]) == {"s0"}
+    _, cyc = solve._plan(st, {"base": "s0", "r1": "s0"}, ["r1"])
+    assert set(cyc.exploration) == {"r1"}
+    py_trees.blackboard.Blackboard.clear()
