@@ -902,7 +902,6 @@ class ExplorationAction(CopsSkill):
             if moving == Status.FAILURE:
                 self.event("exploration_unreachable", at=self._at, choice=self._moving)
                 topo.unreachable.add(self._moving)
-                self._visited.add(self._moving)
                 self._i, self._moving = self._i_before, None
                 return Status.RUNNING
             self._prev, self._at, self._moving = self._at, self._moving, None

@@ -86,6 +86,9 @@ class VoxelNetworkView:
         self._visited: set[str] = set()
         self._trail_seen = 0
         self.extractions = 0
+        #: The home's ground point and cell (fixed: a robot's home does not move).
+        self._home = self.ground_points(np.asarray(robot.home, dtype=float)[None])[0]
+        self._home_cell = self.cell_of(self._home[None])[0]
 
     # -- the NetworkView protocol ---------------------------------------------------------
     def topology(self) -> dict[str, Any]:
@@ -102,8 +105,7 @@ class VoxelNetworkView:
         ground = self.ground_point()
         if locations:
             names = list(locations)
-            home_cell, home = self._home()
-            targets = np.array([home if n == home_cell else locations[n] for n in names], dtype=float)
+            targets = np.array([self._home if n == self._home_cell else locations[n] for n in names], dtype=float)
             gaps = np.linalg.norm(targets - ground, axis=1)
             i = int(np.argmin(gaps))
             if gaps[i] <= ARRIVAL_RADIUS_M:
@@ -155,13 +157,7 @@ class VoxelNetworkView:
         pos = self.current().locations.get(location)
         if pos is None:
             return None
-        home_cell, home = self._home()
-        return home if location == home_cell else np.asarray(pos, dtype=float)
-
-    def _home(self) -> tuple[str, np.ndarray]:
-        """The cell of the robot's home and the home's ground point."""
-        home = self.ground_points(np.asarray(self.robot.home, dtype=float)[None])[0]
-        return self.cell_of(home[None])[0], home
+        return self._home.copy() if location == self._home_cell else np.asarray(pos, dtype=float)
 
     def cell_of(self, points: np.ndarray) -> list[str]:
         """The names of the lattice cells of ground points (N, 3)."""

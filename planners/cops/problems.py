@@ -498,7 +498,7 @@ def _trim(plan: Plan) -> Plan:
     return plan
 
 
-def _horizon_of(traj: Mapping[str, list[str]] | None) -> int | None:
+def horizon_of(traj: Mapping[str, list[str]] | None) -> int | None:
     if traj is None:
         return None
     return max((len(tr) for tr in traj.values()), default=1) - 1
@@ -619,12 +619,12 @@ def solve_pre_exploration(network: MCNetwork, *, positions: Mapping[str, str] | 
     greedy = None
     if not (col_r and col_s):  # the greedy rules know nothing of collisions
         greedy = greedy_pre_plan(network, pos, ms, st, ex, rewards, sinks)
-    T_h = _horizon_of(greedy)
+    T_h = horizon_of(greedy)
     hi = max_horizon if max_horizon is not None else max(lower + 2 * horizon_patience + 2, len(network),
                                                          (T_h or 0) + horizon_patience)
 
     def make(T: int, warm=None, tw: float = 0.0, limit: float | None = None) -> Plan | None:
-        if warm is not None and _horizon_of(warm) > T:
+        if warm is not None and horizon_of(warm) > T:
             warm = None
         return solve_connectivity(ConnectivityProblem(
             network=network, horizon=T, positions=pos, masters=ms, static=st, explorers=ex,
@@ -723,7 +723,7 @@ def solve_post_exploration(network: MCNetwork, *, sources: Iterable[str], positi
     if not (col_r and col_s):
         greedy = greedy_post_plan(network, pos, ms, st, srcs, base,
                                   sink_final_location if moving_sink else None)
-    T_h = _horizon_of(greedy)
+    T_h = horizon_of(greedy)
     hi = max_horizon if max_horizon is not None else \
         max(int(min(lower, len(network)) + len(network) // 2 + 4), T_h or 0)
     for r in srcs:
@@ -736,7 +736,7 @@ def solve_post_exploration(network: MCNetwork, *, sources: Iterable[str], positi
              limit: float | None = None) -> Plan | None:
         q = req if sub is None else [Requirement(tuple(sub), (base,))]
         o = replace(opts, mip_gap=None) if probe else opts
-        if warm is not None and _horizon_of(warm) > T:
+        if warm is not None and horizon_of(warm) > T:
             warm = None
         return solve_connectivity(ConnectivityProblem(
             network=network, horizon=T, positions=pos, masters=ms, static=st, explorers=set(),

@@ -16,7 +16,7 @@ from typing import Iterable, Mapping
 from .ilp import ConnectivityProblem, InfeasibleProblem, SolverOptions, SolverTimeout, solve_connectivity
 from .network import MCNetwork
 from .plan import MASTER, Communication, Plan, idle_plan
-from .problems import _horizon_of, greedy_pre_plan
+from .problems import horizon_of, greedy_pre_plan
 
 #: Reward for each robot brought home; larger than any route's mobility cost.
 DEFAULT_HOME_REWARD = 1000.0
@@ -46,7 +46,7 @@ def solve_recall(network: MCNetwork, *, positions: Mapping[str, str], masters: I
     opts = options or SolverOptions()
     rewards = {base: (home_reward,) * len(mobile)}
     greedy = greedy_pre_plan(network, positions, ms, st, mobile, rewards)
-    T_greedy = _horizon_of(greedy)
+    T_greedy = horizon_of(greedy)
 
     def solve(T: int) -> Plan | None:
         warm = greedy if T_greedy is not None and T_greedy <= T else None
