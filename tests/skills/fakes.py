@@ -1,11 +1,14 @@
 """A small fake robot for skill tests: it walks paths in straight lines over a fixed
-synthetic map (no world, no LiDAR), and the helpers that tick a skill on it."""
+synthetic map (no world, no LiDAR), with a scripted radio, and the helpers that tick a
+skill on it."""
 from __future__ import annotations
 
+from collections import deque
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
-from delve.planners.occupancy import FREE, Grid
+from delve.planners.occupancy import FREE, UNKNOWN, Grid
 from delve.skills.base import AgentContext
 from delve.skills.robot import PathStatus
 from py_trees.common import Status
@@ -27,26 +30,112 @@ class FakeMobility:
 
 
 class FakeMap:
-    """A fixed onboard map."""
+    """An onboard map that changes only when a test (or ``reset_local_map``) writes to
+    it; the first write copies the grid, so a grid shared between tests stays as it is."""
 
     def __init__(self, grid: Grid):
         self.occupancy, self.origin, self.voxel_size_m, self.version = grid.occupancy, grid.origin, grid.voxel_size_m, 1
+        self._own = False
+        self._changed: dict[int, int] = {}
 
     def free_voxels(self) -> np.ndarray:
         return np.flatnonzero(self.occupancy.reshape(-1) == FREE)
 
+    def write(self, flat, value: int) -> None:
+        """Set the voxels ``flat`` (flat indices or a boolean mask of the grid's shape)
+        to ``value``, as a scan would: the version goes up and ``take_changes`` reports them."""
+        flat = np.asarray(flat)
+        if flat.dtype == bool:
+            flat = np.flatnonzero(flat.reshape(-1))
+        if not self._own:
+            self.occupancy, self._own = self.occupancy.copy(), True
+        self.occupancy.reshape(-1)[flat] = value
+        self._changed.update(dict.fromkeys(flat.tolist(), int(value)))
+        self.version += 1
+
     def take_changes(self) -> tuple[np.ndarray, np.ndarray]:
-        return np.zeros(0, np.int64), np.zeros(0, np.int8)
+        flat = np.array(sorted(self._changed), np.int64)
+        values = np.array([self._changed[i] for i in flat.tolist()], np.int8)
+        self._changed = {}
+        return flat, values
+
+
+@dataclass(frozen=True)
+class FakeMessage:
+    sender: str
+    recipient: str
+    kind: str
+    data: Any
+    sent_s: float = 0.0
+
+
+class FakeRadio:
+    """A radio with a scripted link. ``link_up`` answers ``linked_to``, and ``ping``
+    while ``ping_results`` (results to give, oldest first) is empty. ``send`` keeps
+    every message in ``sent`` (and in ``outbox`` until :meth:`flush`, as a real radio
+    keeps them while the link is down); ``deliver`` puts a message in the inbox."""
+
+    def __init__(self, name: str = "r1", clock: Any = None):
+        self.name = name
+        self.clock = clock
+        self.link_up = True
+        self.ping_results: deque[bool] = deque()
+        self.pings: list[tuple[float, str]] = []
+        self.sent: list[FakeMessage] = []
+        self.outbox: list[FakeMessage] = []
+        self.inbox: list[FakeMessage] = []
+
+    def _now(self) -> float:
+        return self.clock.now_s if self.clock is not None else 0.0
+
+    def send(self, recipient: str, kind: str, data: Any) -> None:
+        msg = FakeMessage(self.name, recipient, kind, data, self._now())
+        self.sent.append(msg)
+        self.outbox.append(msg)
+
+    def flush(self) -> list[FakeMessage]:
+        """The messages that leave the outbox when the link carries them."""
+        out, self.outbox = self.outbox, []
+        return out
+
+    def deliver(self, sender: str, kind: str, data: Any, sent_s: float = 0.0) -> None:
+        self.inbox.append(FakeMessage(sender, self.name, kind, data, sent_s))
+
+    def receive(self) -> list[FakeMessage]:
+        out, self.inbox = self.inbox, []
+        return out
+
+    def linked_to(self, other: str) -> bool:
+        return self.link_up
+
+    @property
+    def pending(self) -> int:
+        return len(self.outbox)
+
+    def ping(self, other: str) -> bool:
+        self.pings.append((self._now(), other))
+        return self.ping_results.popleft() if self.ping_results else self.link_up
+
+
+@dataclass(frozen=True)
+class FakeDrop:
+    ok: bool
+    name: str | None
+    remaining: int
+    error: str = ""
 
 
 class FakeRobot:
     """Follows paths in straight lines at its speed when :meth:`step` is called, facing
     the way it walks; a path is BLOCKED where it first comes within ``block_radius_m``
-    of ``block_at``. ``payload`` is what the robot carries (e.g. the simulator's
-    pan-tilt-zoom camera: skills work out occlusion on the onboard map)."""
+    of ``block_at``. While ``jammed_s`` > 0 (see :meth:`jam`) it follows its path
+    without moving, as the simulator's jam fault does. ``payload`` is what the robot
+    carries (e.g. the simulator's pan-tilt-zoom camera: skills work out occlusion on
+    the onboard map). ``radio`` is a :class:`FakeRadio`; the robot carries
+    ``breadcrumbs`` and has ground under it to drop them on while ``has_ground``."""
 
     def __init__(self, grid: Grid, position, home=None, platform: str = "legged", trail=None,
-                 endurance_s=3000.0, payload=None):
+                 endurance_s=3000.0, payload=None, breadcrumbs: int = 0):
         self.name = "r1"
         self.platform = platform
         self.mobility = FakeMobility(aerial=platform == "aerial")
@@ -66,6 +155,12 @@ class FakeRobot:
         self.block_radius_m = 0.3
         self.blocked_reason = ""
         self.payload = payload
+        self.radio = FakeRadio(self.name)
+        self.jammed_s = 0.0
+        self.breadcrumbs = breadcrumbs
+        self.has_ground = True
+        self.drops: list[np.ndarray] = []
+        self.map_resets: list[float] = []
 
     @property
     def position(self) -> np.ndarray:
@@ -97,8 +192,32 @@ class FakeRobot:
         if self.path_status == PathStatus.FOLLOWING:
             self.path_status = PathStatus.IDLE
 
+    def jam(self, duration_s: float) -> None:
+        """The feet are stuck for ``duration_s`` of :meth:`step` time."""
+        self.jammed_s = max(self.jammed_s, duration_s)
+
+    def deploy_breadcrumb(self) -> FakeDrop:
+        if self.breadcrumbs <= 0:
+            return FakeDrop(False, None, 0, f"{self.name} has no breadcrumbs left")
+        if not self.has_ground:
+            return FakeDrop(False, None, self.breadcrumbs, f"{self.name} has no ground below to drop a breadcrumb on")
+        self.breadcrumbs -= 1
+        self.drops.append(self.position)
+        return FakeDrop(True, f"{self.name}_crumb{len(self.drops)}", self.breadcrumbs)
+
+    def reset_local_map(self, radius_m: float) -> None:
+        """Forget the map within ``radius_m`` of the robot (set it UNKNOWN)."""
+        self.map_resets.append(radius_m)
+        m = self.onboard_map
+        idx = np.indices(m.occupancy.shape).reshape(3, -1).T
+        centres = m.origin + (idx + 0.5) * m.voxel_size_m
+        m.write(np.linalg.norm(centres - self._pos, axis=1) <= radius_m, UNKNOWN)
+
     def step(self, dt_s: float = 1.0) -> None:
         if self.path_status != PathStatus.FOLLOWING or self.path is None:
+            return
+        if self.jammed_s > 0:
+            self.jammed_s = max(0.0, self.jammed_s - dt_s)
             return
         budget = self.mobility.speed_mps * dt_s
         while budget > 1e-9 and len(self.path):
@@ -126,6 +245,9 @@ def make_ctx(robot, name: str = "r1") -> AgentContext:
     events: list[tuple[str, dict]] = []
     ctx = AgentContext(name=name, namespace=f"/{name}", clock=Clock(),
                        log=lambda event, **fields: events.append((event, fields)), robot=robot)
+    radio = getattr(robot, "radio", None)
+    if isinstance(radio, FakeRadio) and radio.clock is None:
+        radio.clock = ctx.clock  # messages carry the sim time they were sent at
     ctx.events = events  # type: ignore[attr-defined]
     return ctx
 
