@@ -5,13 +5,21 @@ from __future__ import annotations
 
 from collections import deque
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
+import py_trees
+import yaml
+from delve.executive.tree_loader import build_tree
 from delve.planners.occupancy import FREE, UNKNOWN, Grid
 from delve.skills.base import AgentContext
 from delve.skills.robot import PathStatus
 from py_trees.common import Status
+
+
+#: The shipped trees (and their subtrees).
+TREES = Path(__file__).resolve().parents[2] / "trees"
 
 
 class Clock:
@@ -265,3 +273,14 @@ def run(node, ctx, robot, ticks: int = 200, dt_s: float = 1.0) -> Status:
 
 def events(ctx, kind: str) -> list[dict]:
     return [f for e, f in ctx.events if e == kind]
+
+
+def build(text: str, ctx, within: Path = TREES):
+    """Build the tree node written in YAML ``text`` for the agent ``ctx``, as a tree
+    file in ``within`` names it (so ``include: subtrees/x.yaml`` finds shipped subtrees)."""
+    return build_tree(yaml.safe_load(text), ctx, file=within / "inline.yaml")
+
+
+def bb(key: str, agent: str = "r1", default: Any = None) -> Any:
+    """An agent's blackboard entry, ``default`` when it was never written."""
+    return py_trees.blackboard.Blackboard.storage.get(f"/{agent}/{key}", default)
