@@ -39,9 +39,10 @@ bench: setup
 	$(BIN)/python bench/bt_overhead.py
 	$(BIN)/python bench/gbplanner.py
 
-# Regenerate the tree JSON Schema and docs/nodes.md from the node registry.
+# Regenerate the tree JSON Schema and docs/nodes.md from the node registry, into this
+# source tree (the generator writes only where it is told, never into site-packages).
 docs: setup
-	$(BIN)/python -m delve.executive.registry --write-schema --write-docs
+	$(BIN)/python -m delve.executive.generate --schema-dir executive/schema --docs docs/nodes.md
 
 clean:
 	rm -rf $(VENV) delve-out .pytest_cache

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import py_trees
 import pytest
-from delve.executive import registry as reg
+from delve.executive.builtin_nodes import BUILTINS
 from delve.executive.errors import DelveError
 from delve.executive.registry import Registry, skill_types
 from delve.executive.tree_loader import build_tree, check_tree, compose_remap, load_tree
@@ -212,7 +212,7 @@ class Fragile(Skill):
 
 
 def fragile_registry():
-    return Registry([*reg._BUILTINS, *skill_types({"Fragile": Fragile})])
+    return Registry([*BUILTINS, *skill_types({"Fragile": Fragile})])
 
 
 def test_skill_is_built_with_checked_params_and_remap(tmp_path):

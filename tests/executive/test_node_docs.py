@@ -1,0 +1,27 @@
+"""delve.executive.node_docs: the node reference, and the shipped docs/nodes.md."""
+from __future__ import annotations
+
+from pathlib import Path
+
+from delve.executive import node_docs
+from delve.executive.registry import default_registry
+
+#: docs/nodes.md of this source tree (it is not package data).
+DOCS_FILE = Path(__file__).resolve().parents[2] / "docs" / "nodes.md"
+
+
+def test_shipped_node_reference_equals_the_generated_one():
+    shipped = DOCS_FILE.read_text(encoding="utf-8")
+    assert shipped == node_docs.reference_markdown(), (
+        "docs/nodes.md is out of date; regenerate it with `python -m delve.executive.registry --write-docs`"
+    )
+
+
+def test_every_node_type_is_described_with_its_parameters():
+    registry = default_registry()
+    reference, listing = node_docs.reference_markdown(registry), node_docs.describe(registry)
+    for node_type in registry:
+        assert f"### {node_type.name}\n" in reference
+        assert f"{node_type.name} [{node_type.kind}]" in listing
+        for pname in node_type.params:
+            assert f"| `{pname}` |" in reference
