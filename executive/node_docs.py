@@ -37,7 +37,7 @@ def reference_markdown(registry: Registry | None = None) -> str:
     registry = default_registry() if registry is None else registry
     out = ["# Node reference", "",
            "Every node type a YAML tree can name. Generated from the registry by "
-           "`python -m delve.executive.registry --write-docs`; do not edit by hand.", ""]
+           "`make docs`; do not edit by hand.", ""]
     titles = {"composite": "Composites", "decorator": "Decorators", "behaviour": "Behaviours",
               "idiom": "Idioms", "skill": "Skills"}
     for kind in KINDS:

@@ -20,7 +20,8 @@ __all__ = ["SCHEMA_FILE_NAME", "SCHEMA_PATH", "param_schema", "schema_text", "tr
 SCHEMA_FILE_NAME = "tree.schema.json"
 #: The shipped copy, package data next to this module.
 SCHEMA_PATH = Path(__file__).resolve().parent / "schema" / SCHEMA_FILE_NAME
-SCHEMA_COMMAND = "python -m delve.executive.registry --write-schema"
+#: How the shipped copy is regenerated in a source tree (the file names it).
+SCHEMA_COMMAND = "make docs"
 
 _JSON_TYPES = {float: "number", int: "integer", bool: "boolean", str: "string", list: "array", dict: "object"}
 

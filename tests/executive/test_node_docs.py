@@ -13,7 +13,7 @@ DOCS_FILE = Path(__file__).resolve().parents[2] / "docs" / "nodes.md"
 def test_shipped_node_reference_equals_the_generated_one():
     shipped = DOCS_FILE.read_text(encoding="utf-8")
     assert shipped == node_docs.reference_markdown(), (
-        "docs/nodes.md is out of date; regenerate it with `python -m delve.executive.registry --write-docs`"
+        "docs/nodes.md is out of date; regenerate it with `make docs`"
     )
 
 
