@@ -284,3 +284,9 @@ def build(text: str, ctx, within: Path = TREES):
 def bb(key: str, agent: str = "r1", default: Any = None) -> Any:
     """An agent's blackboard entry, ``default`` when it was never written."""
     return py_trees.blackboard.Blackboard.storage.get(f"/{agent}/{key}", default)
+
+
+def body(p, dx: float = 0.0, dy: float = 0.0) -> np.ndarray:
+    """The body centre of a legged robot standing ``dx`` along and ``dy`` across from the
+    floor point ``p`` of a synthetic tunnel (floor at ``p``'s z, body 0.5 m above)."""
+    return np.asarray(p, float) + np.array([dx, dy, 0.5])

@@ -8,8 +8,7 @@ from delve.planners.gbplanner2 import synthetic as syn
 from delve.planners.occupancy import OCCUPIED, UNKNOWN
 from delve.skills.navigation import Navigator, Plan, navigator
 
-from .fakes import FakeRobot, make_ctx
-from .test_motion import body
+from .fakes import FakeRobot, body, make_ctx
 
 
 @pytest.fixture(scope="module")

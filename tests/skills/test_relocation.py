@@ -8,8 +8,7 @@ import pytest
 from delve.planners.gbplanner2 import synthetic as syn
 from py_trees.common import Status
 
-from .fakes import FakeRobot, bb, build, events, make_ctx, run
-from .test_motion import body
+from .fakes import FakeRobot, bb, body, build, events, make_ctx, run
 
 EXPLORE = """
 type: Explore
