@@ -49,16 +49,18 @@ class FakeMap:
     def free_voxels(self) -> np.ndarray:
         return np.flatnonzero(self.occupancy.reshape(-1) == FREE)
 
-    def write(self, flat, value: int) -> None:
+    def write(self, flat, values) -> None:
         """Set the voxels ``flat`` (flat indices or a boolean mask of the grid's shape)
-        to ``value``, as a scan would: the version goes up and ``take_changes`` reports them."""
+        to ``values`` (one value or one each), as a scan would: the version goes up and
+        ``take_changes`` reports them."""
         flat = np.asarray(flat)
         if flat.dtype == bool:
             flat = np.flatnonzero(flat.reshape(-1))
+        values = np.broadcast_to(np.asarray(values, np.int8), flat.shape)
         if not self._own:
             self.occupancy, self._own = self.occupancy.copy(), True
-        self.occupancy.reshape(-1)[flat] = value
-        self._changed.update(dict.fromkeys(flat.tolist(), int(value)))
+        self.occupancy.reshape(-1)[flat] = values
+        self._changed.update(zip(flat.tolist(), values.tolist()))
         self.version += 1
 
     def take_changes(self) -> tuple[np.ndarray, np.ndarray]:
