@@ -4,7 +4,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test setup system-deps bench docs clean
+.PHONY: demo test setup system-deps bench docs clean wheel-check
 
 
 demo: setup
@@ -31,7 +31,8 @@ $(VENV)/bin/python:
 
 $(STAMP): $(VENV)/bin/python pyproject.toml
 	$(BIN)/pip install -q --upgrade pip
-	$(BIN)/pip install -q -e '.[test]'
+	# The editable install's note about same-named folders is the only thing it would print.
+	PYTHONWARNINGS="ignore:Editable installation" $(BIN)/pip install -q -e '.[test]'
 	touch $(STAMP)
 
 bench: setup
@@ -44,5 +45,20 @@ bench: setup
 docs: setup
 	$(BIN)/python -m delve.executive.generate --schema-dir executive/schema --docs docs/nodes.md
 
+# Build the wheel, install it into a fresh venv and run it from an empty folder:
+# the shipped trees and scenarios validate, and the demo runs.
+WHEEL_TMP := $(shell mktemp -d -u /tmp/delve-wheel-XXXXXX)
+wheel-check: system-deps
+	$(PYTHON) -m venv $(WHEEL_TMP)/venv
+	$(WHEEL_TMP)/venv/bin/pip install -q --upgrade pip
+	$(WHEEL_TMP)/venv/bin/pip wheel -q --no-deps -w $(WHEEL_TMP)/dist .
+	rm -rf build
+	$(WHEEL_TMP)/venv/bin/pip install -q $(WHEEL_TMP)/dist/delve-*.whl
+	mkdir -p $(WHEEL_TMP)/empty
+	cd $(WHEEL_TMP)/empty && $(WHEEL_TMP)/venv/bin/delve validate --shipped >/dev/null
+	cd $(WHEEL_TMP)/empty && $(WHEEL_TMP)/venv/bin/delve demo --quiet
+	test -s $(WHEEL_TMP)/empty/delve-out/demo/report.json
+	rm -rf $(WHEEL_TMP)
+
 clean:
-	rm -rf $(VENV) delve-out .pytest_cache
+	rm -rf $(VENV) delve-out .pytest_cache build

@@ -22,7 +22,7 @@ import time
 from dataclasses import replace
 
 from delve import SCENARIOS_DIR
-from delve.executive.graph_mission import GraphMission
+from delve.executive.runner import Mission
 from delve.executive.outputs import report
 from delve.executive.scenario import load_scenario
 
@@ -30,10 +30,10 @@ from delve.executive.scenario import load_scenario
 def run(n_robots: int, seed: int, duration_s: float) -> tuple[dict, float]:
     sc = load_scenario(SCENARIOS_DIR / "cops_tunnel.yaml")
     template = sc.robots[0]
-    robots = [replace(template, name=f"r{i + 1}") for i in range(n_robots)]
+    robots = [replace(template, name=f"r{i + 1}", endurance_s=duration_s) for i in range(n_robots)]
     sc = replace(sc, robots=robots, seed=seed)
     t0 = time.perf_counter()
-    mission = GraphMission(sc, duration_s=duration_s)
+    mission = Mission(sc, duration_s=duration_s)
     mission.run()
     wall = time.perf_counter() - t0
     return report(mission, wall), wall

@@ -1,7 +1,7 @@
 """The ``delve`` command line.
 
     delve run SCENARIO [--out DIR] [--seed N] [--duration-s S] [--quiet]
-    delve validate FILE...
+    delve validate FILE... | --shipped
     delve render TREE --format svg|dot|png|txt [--out PATH]
     delve demo
 
@@ -13,9 +13,10 @@ from __future__ import annotations
 import argparse
 import sys
 import time
+import warnings
 from pathlib import Path
 
-from .. import SCENARIOS_DIR
+from .. import SCENARIOS_DIR, TREES_DIR
 from .errors import DelveError
 from .yamlio import YamlDict, load_yaml
 
@@ -26,13 +27,14 @@ def _parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="delve", description="Behaviour-tree mission executive for subterranean robot teams.")
     sub = p.add_subparsers(dest="command", required=True)
     run = sub.add_parser("run", help="run a scenario and write its outputs")
-    run.add_argument("scenario", type=Path)
+    run.add_argument("scenario", type=Path, help="a scenario file, or the name of a shipped one (demo, cops_tunnel, ...)")
     run.add_argument("--out", type=Path, help="output directory (default: delve-out/<scenario name>)")
     run.add_argument("--seed", type=int, help="override the scenario's seed")
     run.add_argument("--duration-s", type=float, help="override the scenario's duration (sim seconds)")
     run.add_argument("--quiet", action="store_true", help="no progress bar")
     val = sub.add_parser("validate", help="check tree and scenario files")
-    val.add_argument("files", type=Path, nargs="+")
+    val.add_argument("files", type=Path, nargs="*")
+    val.add_argument("--shipped", action="store_true", help="also check every shipped tree and scenario")
     ren = sub.add_parser("render", help="draw a tree file")
     ren.add_argument("tree", type=Path)
     ren.add_argument("--format", choices=("svg", "dot", "png", "txt"), default="txt")
@@ -42,15 +44,29 @@ def _parser() -> argparse.ArgumentParser:
     return p
 
 
+def _one_line_warning(message, category, filename, lineno, file=None, line=None) -> None:  # noqa: ANN001
+    """Print a warning (a deprecation in a user's file, say) as one line."""
+    print(f"warning: {message}", file=sys.stderr)
+
+
 def main(argv: list[str] | None = None) -> int:
     args = _parser().parse_args(argv)
+    with warnings.catch_warnings():
+        warnings.showwarning = _one_line_warning
+        return _command(args)
+
+
+def _command(args: argparse.Namespace) -> int:
     try:
         if args.command == "run":
-            return run(args.scenario, args.out, args.seed, args.duration_s, args.quiet)
+            return run(shipped_or_given(args.scenario), args.out, args.seed, args.duration_s, args.quiet)
         if args.command == "demo":
             return run(DEMO_SCENARIO, Path("delve-out/demo"), None, None, args.quiet)
         if args.command == "validate":
-            return validate(args.files)
+            shipped = sorted(TREES_DIR.rglob("*.yaml")) + sorted(SCENARIOS_DIR.glob("*.yaml")) if args.shipped else []
+            if not args.files and not shipped:
+                raise DelveError("validate: name the files to check, or --shipped")
+            return validate(args.files + shipped)
         if args.command == "render":
             return render(args.tree, args.format, args.out)
     except DelveError as err:
@@ -59,10 +75,19 @@ def main(argv: list[str] | None = None) -> int:
     return 2
 
 
+def shipped_or_given(path: Path) -> Path:
+    """``path``, or the shipped scenario of that name when ``path`` is a bare name
+    that is no file here (``delve run demo``)."""
+    shipped = SCENARIOS_DIR / f"{path}.yaml"
+    if not path.exists() and len(path.parts) == 1 and not path.suffix and shipped.exists():
+        return shipped
+    return path
+
+
 def run(path: Path, out: Path | None, seed: int | None, duration_s: float | None, quiet: bool) -> int:
     """Run a scenario, write its outputs, print a summary; exit status per the mission."""
     from .outputs import write_outputs
-    from .runner import create_mission
+    from .runner import Mission
     from .scenario import load_scenario
 
     if seed is not None and seed < 0:
@@ -72,7 +97,7 @@ def run(path: Path, out: Path | None, seed: int | None, duration_s: float | None
     scenario = load_scenario(path)
     out = out or Path("delve-out") / scenario.name
     started = time.perf_counter()
-    mission = create_mission(scenario, seed=seed, duration_s=duration_s)
+    mission = Mission(scenario, seed=seed, duration_s=duration_s)
     if quiet:
         mission.run()
     else:

@@ -4,8 +4,8 @@ Every mistake becomes a one-line :class:`DelveError` with the file and line.
 """
 from __future__ import annotations
 
-import inspect
 import json
+import warnings
 import math
 from dataclasses import dataclass, field
 from functools import lru_cache
@@ -14,20 +14,13 @@ from typing import Any
 
 import jsonschema
 
-from ..sim import worldgen
-from ..sim.graph_world import GraphWorld
-from . import graph_worlds
-from ..sim.world import World
 from .errors import DelveError, did_you_mean
 from .supervisor import Command, load_supervisor
-
+from .teams import DEFAULT_STRATEGY, TEAM_STRATEGIES, TeamStrategy, implied_strategy
+from .worlds import WorldBackend, backend_for, generator_names
 from .yamlio import YamlDict, YamlList, load_yaml, plain
 
 SCHEMA_PATH = Path(__file__).parent / "schema" / "scenario.schema.json"
-GENERATORS = ("tunnel_network", "cave") + graph_worlds.GRAPH_GENERATORS
-#: Radio settings that mean something on a graph world (communication edges decide links).
-GRAPH_RADIO_KEYS = ("loss", "update_period_s")
-MESH_OPTIONS = ("mesh", "scale", "up_axis", "voxel_size_m", "start", "seed")
 DEFAULTS = {"seed": 0, "duration_s": 3600.0, "dt_s": 0.1, "coverage_period_s": 5.0}
 
 
@@ -66,6 +59,19 @@ class Fault:
     duration_s: float = 0.0
 
 
+class DelveDeprecation(UserWarning):
+    """A scenario or tree uses a form that still works but will go: the message says
+    what to write instead."""
+
+
+@dataclass(frozen=True)
+class TeamSpec:
+    """The scenario's team strategy and its checked parameters."""
+
+    strategy: type[TeamStrategy]
+    params: dict[str, Any]
+
+
 @dataclass
 class Scenario:
     """A checked scenario: plain values, resolved paths and where each came from."""
@@ -83,40 +89,22 @@ class Scenario:
     base_tick_hz: float
     radio: dict[str, float]
     doc: YamlDict
+    world_backend: type[WorldBackend]
+    team: TeamSpec
     supervisor: list[Command] = field(default_factory=list)
     faults: list[Fault] = field(default_factory=list)
 
-    @property
-    def is_graph(self) -> bool:
-        """Whether the world is a graph world (a network file or a graph generator)."""
-        return "network" in self.world or self.world.get("generator") in graph_worlds.GRAPH_GENERATORS
+    def team_strategy(self) -> TeamStrategy:
+        """A fresh instance of the scenario's team strategy."""
+        return self.team.strategy(**self.team.params)
 
-    def build_world(self, seed: int | None = None) -> World | GraphWorld:
+    def build_world(self, seed: int | None = None) -> Any:
         """Generate or load the world (a DelveError when its parameters are wrong).
 
         A generator without its own ``seed`` takes ``seed``, else the scenario's."""
-        spec = dict(self.world)
-        line = self.doc["world"].line
-        try:
-            if "network" in spec:
-                return graph_worlds.load_network_world(self.path.parent / spec["network"])
-            if spec.get("generator") in graph_worlds.GRAPH_GENERATORS:
-                gen = getattr(graph_worlds, spec.pop("generator"))
-                spec.setdefault("seed", self.seed if seed is None else seed)
-                return gen(**spec)
-            if "mesh" in spec:
-                mesh = (self.path.parent / spec.pop("mesh")).resolve()
-                if not mesh.exists():
-                    raise DelveError(f"mesh file not found: {mesh}", self.path, self.doc["world"].key_line("mesh"))
-                spec.pop("seed", None)
-                return worldgen.from_mesh(mesh, **spec)
-            gen = getattr(worldgen, spec.pop("generator"))
-            spec.setdefault("seed", self.seed if seed is None else seed)
-            return gen(**spec)
-        except ValueError as err:
-            raise DelveError(f"world: {err}", self.path, line) from None
+        return self.world_backend.build_world(self, self.seed if seed is None else seed)
 
-    def check_starts(self, world: World) -> None:
+    def check_starts(self, world: Any) -> None:
         """Each robot's start pose must be inside the world and in free space."""
         for r in self.robots:
             if r.start is None:
@@ -167,40 +155,54 @@ def _nan(doc: Any, path: Path) -> None:
         _nan(v, path)
 
 
-def _world_params(world: YamlDict, path: Path) -> None:
-    if "mesh" in world:
-        allowed = MESH_OPTIONS
-    elif "network" in world:
-        allowed = ("network",)
-    else:
-        module = graph_worlds if world["generator"] in graph_worlds.GRAPH_GENERATORS else worldgen
-        allowed = ("generator",) + tuple(inspect.signature(getattr(module, world["generator"])).parameters)
-    for key in world:
-        if key not in allowed:
-            raise DelveError(f"world: unknown parameter {key!r}{did_you_mean(key, allowed)}", path,
-                             world.key_line(key))
-
-
-def _graph_checks(doc: YamlDict, path: Path, base_tree: Path | None, faults: list[Fault]) -> None:
-    """What a graph world needs and refuses: a base station tree, a readable network
-    file, no voxel-world radio settings or faults."""
+def _world_backend(doc: YamlDict, path: Path) -> type[WorldBackend]:
+    """The backend that claims the scenario's ``world:``; a DelveError if none does."""
     world = doc["world"]
-    if "network" in world:
-        net_path = path.parent / world["network"]
-        if not net_path.exists():
-            raise DelveError(f"network file not found: {world['network']}", path, world.key_line("network"))
-        graph_worlds.load_network_world(net_path)
-    if base_tree is None:
-        raise DelveError("a graph world needs a base station tree (base_station: tree: ...), the COPS leader",
-                         path, doc.key_line("base_station") or doc.key_line("world"))
-    for key in doc.get("radio", {}):
-        if key not in GRAPH_RADIO_KEYS:
-            raise DelveError(f"radio: {key!r} does not apply to a graph world (communication edges decide links; "
-                             f"use {', '.join(GRAPH_RADIO_KEYS)})", path, doc["radio"].key_line(key))
-    for i, f in enumerate(faults):
-        if f.kind == "map_artifact":
-            raise DelveError("a 'map_artifact' fault needs a voxel map; a graph world has none", path,
-                             doc["faults"].item_line(i))
+    backend = backend_for(world)
+    if backend is None:
+        names = generator_names()
+        name = world.get("generator")
+        raise DelveError(f"world/generator: {name!r} is not one of {', '.join(map(repr, names))}"
+                         f"{did_you_mean(str(name), names)}", path, world.key_line("generator") or world.line)
+    return backend
+
+
+def _team(doc: YamlDict, path: Path, base_types: set[type], tree_types: set[type]) -> TeamSpec:
+    """The scenario's team strategy with its checked parameters. Without ``team:``,
+    the strategy the base station tree implies (with a deprecation warning that names
+    the key to add), else the default. Trees whose nodes need another strategy than
+    the one named are a mistake."""
+    team = doc.get("team")
+    if team is None:
+        name = implied_strategy(base_types)
+        if name is None:
+            return TeamSpec(TEAM_STRATEGIES[DEFAULT_STRATEGY], {})
+        warnings.warn(DelveDeprecation(
+            f"{path}: no 'team:' key; the base station tree implies strategy {name!r}. "
+            f"Add 'team: {{strategy: {name}}}' (a scenario without it will be an independent team)"), stacklevel=2)
+        return TeamSpec(TEAM_STRATEGIES[name], {})
+    name = team["strategy"]
+    if name not in TEAM_STRATEGIES:
+        raise DelveError(f"team: unknown strategy {name!r}{did_you_mean(name, TEAM_STRATEGIES)} "
+                         f"(one of {', '.join(map(repr, TEAM_STRATEGIES))})", path, team.key_line("strategy"))
+    strategy = TEAM_STRATEGIES[name]
+    needed = implied_strategy(tree_types)
+    if needed is not None and needed != name:
+        raise DelveError(f"team: the trees use behaviours of strategy {needed!r}, not {name!r} "
+                         f"(use 'strategy: {needed}')", path, team.key_line("strategy"))
+    params = {}
+    for key, value in team.items():
+        if key == "strategy":
+            continue
+        spec = strategy.PARAMS.get(key)
+        if spec is None:
+            raise DelveError(f"team: unknown parameter {key!r} of strategy {name!r}"
+                             f"{did_you_mean(key, strategy.PARAMS)}", path, team.key_line(key))
+        problem = spec.problem(value)
+        if problem:
+            raise DelveError(f"team: {key} {problem}", path, team.key_line(key))
+        params[key] = float(value) if spec.type is float else value
+    return TeamSpec(strategy, params)
 
 
 def load_scenario(path: str | Path) -> Scenario:
@@ -214,10 +216,10 @@ def load_scenario(path: str | Path) -> Scenario:
                     key=lambda e: (len(e.absolute_path), list(map(str, e.absolute_path))))
     if errors:
         raise _schema_error(jsonschema.exceptions.best_match(errors), doc, path)
-    _world_params(doc["world"], path)
+    backend = _world_backend(doc, path)
     from .tree_loader import check_tree
 
-    robots, names = [], set()  # names: the robots seen so far
+    robots, names, tree_types = [], set(), set()  # names: the robots seen so far
     for i, r in enumerate(doc["robots"]):
         line = doc["robots"].item_line(i)
         if r["name"] in names or r["name"] == "base":
@@ -227,7 +229,7 @@ def load_scenario(path: str | Path) -> Scenario:
         tree = (path.parent / r["tree"]).resolve()
         if not tree.exists():
             raise DelveError(f"robot {r['name']!r}: tree file not found: {r['tree']}", path, r.key_line("tree"))
-        check_tree(tree)
+        tree_types |= check_tree(tree)
         extra = {k: float(r[k]) for k in ("speed_mps", "max_inclination_deg", "max_step_m") if k in r}
         robots.append(RobotSpec(name=r["name"], platform=r["platform"], tree=tree, start=r.get("start"),
                                 endurance_s=r.get("endurance_s"), tick_hz=float(r.get("tick_hz", 5.0)),
@@ -235,12 +237,13 @@ def load_scenario(path: str | Path) -> Scenario:
                                 line=line, start_line=r.key_line("start")))
 
     base = doc.get("base_station", {})
-    base_tree = None
+    base_tree, base_types = None, set()
     if "tree" in base:
         base_tree = (path.parent / base["tree"]).resolve()
         if not base_tree.exists():
             raise DelveError(f"base station tree file not found: {base['tree']}", path, base.key_line("tree"))
-        check_tree(base_tree)
+        base_types = check_tree(base_tree)
+        tree_types |= base_types
     supervisor = load_supervisor(doc.get("supervisor"), path, {r.name: r.breadcrumbs for r in robots})
     faults = []
     for i, f in enumerate(doc.get("faults", [])):
@@ -251,11 +254,15 @@ def load_scenario(path: str | Path) -> Scenario:
             raise DelveError("a 'stuck' fault needs duration_s", path, doc["faults"].item_line(i))
         faults.append(Fault(float(f["at_s"]), f["robot"], f["kind"], float(f.get("duration_s", 0.0))))
     values = {k: doc.get(k, v) for k, v in DEFAULTS.items()}
-    if "network" in doc["world"] or doc["world"].get("generator") in graph_worlds.GRAPH_GENERATORS:
-        _graph_checks(doc, path, base_tree, faults)
+    backend.check(doc, path, base_tree is not None)
+    team = _team(doc, path, base_types, tree_types)
+    if team.strategy.NEEDS_BASE_TREE and base_tree is None:
+        name = next(n for n, s in TEAM_STRATEGIES.items() if s is team.strategy)
+        raise DelveError(f"team strategy {name!r} needs a base station tree (base_station: tree: ...)", path,
+                         doc.key_line("team"))
     return Scenario(path=path, name=doc["name"], seed=int(values["seed"]), duration_s=float(values["duration_s"]),
                     dt_s=float(values["dt_s"]), coverage_period_s=float(values["coverage_period_s"]),
                     world=plain(doc["world"]), robots=robots, base_tree=base_tree,
                     base_position=base.get("position"), base_tick_hz=float(base.get("tick_hz", 1.0)),
-                    radio=plain(doc.get("radio", {})), doc=doc, supervisor=supervisor,
+                    radio=plain(doc.get("radio", {})), doc=doc, world_backend=backend, team=team, supervisor=supervisor,
                     faults=sorted(faults, key=lambda f: f.at_s))

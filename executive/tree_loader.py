@@ -302,11 +302,13 @@ def _release_blackboard(root: Behaviour) -> None:
                 pass
 
 
-def check_tree(path: str | os.PathLike[str], *, registry: Registry | None = None) -> None:
-    """Check the YAML tree at ``path`` by building it for a dummy agent.
+def check_tree(path: str | os.PathLike[str], *, registry: Registry | None = None) -> set[type]:
+    """Check the YAML tree at ``path`` by building it for a dummy agent; return the
+    classes of its nodes.
 
     Raises:
         DelveError: the first mistake found, with its file, line and node.
     """
     root = load_tree(path, check_context(), registry=registry)
     _release_blackboard(root)
+    return {type(node) for node in root.iterate()}

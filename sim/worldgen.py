@@ -15,6 +15,7 @@ ramps, on every level) and not the vertical shafts.
 from __future__ import annotations
 
 import math
+from importlib.resources import files
 from pathlib import Path
 
 import numpy as np
@@ -31,8 +32,7 @@ __all__ = ["tunnel_network", "cave", "from_mesh", "scanned_mine", "write_scanned
            "SCANNED_MINE_PATH"]
 
 #: The "scanned mine" test asset: a small mine mesh with scan noise, Y-up, in centimetres.
-SCANNED_MINE_PATH = (Path(__file__).resolve().parents[1]
-                     / "scenarios" / "worlds" / "scanned_mine.ply")
+SCANNED_MINE_PATH = Path(str(files("delve.scenarios"))) / "worlds" / "scanned_mine.ply"
 #: How scanned_mine.ply is made (see write_scanned_mine) and must be loaded.
 SCANNED_MINE_SEED = 2024
 SCANNED_MINE_SCALE = 0.01

@@ -37,7 +37,7 @@ from ..planners.cops.plan import Plan, idle_plan
 from ..planners.cops.recall import solve_recall
 from ..planners.cops.topology import Topology, team_network
 from .base import AgentContext, Param, Skill
-from .robot import PathStatus
+from .robot import NetworkView, PathStatus
 
 KIND = "cops"
 PARTS = ("pre", "explore", "post", "done")
@@ -142,17 +142,10 @@ def final_plan_id(cycle: int, robot: str) -> str:
     return f"{cycle}:final:{robot}"
 
 
-def network_view(ctx: AgentContext) -> Any:
-    """The robot's NetworkView: a service, the robot itself, or its voxel map."""
-    view = ctx.services.get("network_view")
-    if view is None and ctx.robot is not None:
-        if hasattr(ctx.robot, "topology"):
-            view = ctx.robot
-        else:
-            from .cops_voxel import VoxelNetworkView
-            view = VoxelNetworkView(ctx.robot)
-        ctx.services["network_view"] = view
-    return view
+def network_view(ctx: AgentContext) -> NetworkView | None:
+    """The robot's NetworkView (service ``network_view``, which the world backend
+    makes for each robot of a COPS team); None at the base station."""
+    return ctx.services.get("network_view")
 
 
 class CopsSkill(Skill):
@@ -172,6 +165,10 @@ class CopsSkill(Skill):
     def __init__(self, name: str, ctx: AgentContext, remap: dict[str, str] | None = None, **params: Any):
         super().__init__(name, ctx, remap, **params)
         self._state_key = self.key(self.p["state"])
+
+    def stored_state(self) -> CopsState | None:
+        """The agent's COPS state; None until a behaviour has made it."""
+        return self.get(self._state_key)
 
     @property
     def state(self) -> CopsState:

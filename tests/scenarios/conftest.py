@@ -4,7 +4,7 @@ from pathlib import Path
 import pytest
 
 from delve.executive.outputs import write_outputs
-from delve.executive.runner import Mission, create_mission
+from delve.executive.runner import Mission
 from delve.executive.scenario import load_scenario
 
 DATA = Path(__file__).parent / "data"
@@ -12,7 +12,7 @@ DATA = Path(__file__).parent / "data"
 
 def run_scenario(path: Path, out: Path | None = None, **kw) -> tuple[Mission, dict]:
     """Run a scenario; write its outputs into ``out`` when given. Returns the mission and report."""
-    mission = create_mission(load_scenario(path), **kw)
+    mission = Mission(load_scenario(path), **kw)
     mission.run()
     report = write_outputs(mission, out, 1.0) if out is not None else None
     return mission, report

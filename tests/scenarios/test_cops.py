@@ -62,7 +62,7 @@ def test_a_lost_robot_triggers_a_replan_and_nothing_the_survivors_found_is_lost(
     assert later[-1]["team"] == ["a", "c"]  # a robot wrongly declared lost is counted again
     assert report["succeeded"]  # the survivors finish
     survivors = set(mission.robots["a"].explored) | set(mission.robots["c"].explored)
-    known = mission.base_state().knowledge.topology.explored
+    known = mission.team.base_state().knowledge.topology.explored
     assert survivors <= known
     assert report["cops"]["plans_valid"] == report["cops"]["cycles"]
 

@@ -1,7 +1,7 @@
 """Graph worlds for COPS scenarios: a generated tunnel-like network, or a network file.
 
 Both become a :class:`delve.sim.graph_world.GraphWorld` (the simulator knows nothing
-of the planner; the executive converts). A malformed network file is rejected when
+of the planner; the graph backend converts). A malformed network file is rejected when
 the scenario is loaded, with its file and line.
 """
 from __future__ import annotations
@@ -10,13 +10,10 @@ import re
 from pathlib import Path
 from typing import Any
 
-from ..planners.cops.network import MCNetwork, network_from_dict, tunnel_network_graph
-from ..sim.graph_world import GraphWorld
-from .errors import DelveError
-from .yamlio import YamlDict, YamlList, load_yaml, plain
-
-#: Graph-world generators a scenario may name, with their parameters.
-GRAPH_GENERATORS = ("tunnel_graph",)
+from ...planners.cops.network import MCNetwork, network_from_dict, tunnel_network_graph
+from ...sim.graph_world import GraphWorld
+from ..errors import DelveError
+from ..yamlio import YamlDict, YamlList, load_yaml, plain
 
 
 def tunnel_graph(n_locations: int = 100, spacing_m: float = 50.0, seed: int = 0, fork_probability: float = 0.2,

@@ -1,0 +1,73 @@
+"""The team strategy seam: how a team method plugs into a mission.
+
+A strategy says which services the base station and the robots get, starts what it
+needs once every agent exists, says when the mission is over and whether it
+succeeded, and adds its figures to ``report.json``. A scenario picks one by name
+(``team: {strategy: NAME, ...parameters}``); its parameters are declared in
+``PARAMS`` and checked when the scenario is loaded.
+"""
+from __future__ import annotations
+
+from abc import ABC
+from typing import TYPE_CHECKING, Any, ClassVar
+
+from py_trees.common import Status
+
+from ...skills.base import Param
+
+if TYPE_CHECKING:
+    from ..runner import Mission
+
+
+class TeamStrategy(ABC):
+    """A team method. The default is every robot on its own: the mission is over when
+    every robot's tree has finished, and it succeeded when each ended in SUCCESS
+    (robots lost to a fault aside)."""
+
+    #: The strategy's parameters (``team:`` keys besides ``strategy``).
+    PARAMS: ClassVar[dict[str, Param]] = {}
+    #: Report fields of this strategy that depend on the wall clock.
+    WALL_CLOCK_FIELDS: ClassVar[tuple[str, ...]] = ()
+    #: Whether the strategy needs a base station tree.
+    NEEDS_BASE_TREE: ClassVar[bool] = False
+
+    def __init__(self, **params: Any):
+        self.params = {k: p.default for k, p in self.PARAMS.items() if not p.required} | params
+
+    @classmethod
+    def implied_by(cls, base_tree_types: set[type]) -> bool:
+        """Whether a scenario without ``team:`` whose base station tree has nodes of
+        ``base_tree_types`` meant this strategy (scenarios from before ``team:``)."""
+        return False
+
+    def robot_services(self, name: str) -> dict[str, Any]:
+        """Services of robot ``name``'s agent, given before its tree is built."""
+        return {}
+
+    def base_services(self) -> dict[str, Any]:
+        """Services of the base station's agent, given before its tree is built."""
+        return {}
+
+    def start(self, mission: "Mission") -> None:
+        """Called once every agent exists, before the first step."""
+
+    def done(self, mission: "Mission") -> bool:
+        """Whether the mission is over."""
+        return all(a.finished for a in mission.robot_agents)
+
+    def succeeded(self, mission: "Mission") -> bool:
+        """Whether the mission succeeded (asked once it is over)."""
+        return all(a.root.status == Status.SUCCESS for a in mission.robot_agents)
+
+    def explored_at_base(self) -> set[str]:
+        """The locations the base station knows to be explored (worlds of locations
+        measure the base station's coverage by them)."""
+        return set()
+
+    def figures(self, mission: "Mission") -> dict[str, Any]:
+        """This strategy's figures for ``report.json`` (deterministic ones)."""
+        return {}
+
+    def wall_clock_figures(self, mission: "Mission") -> dict[str, Any]:
+        """This strategy's figures that depend on the wall clock (``WALL_CLOCK_FIELDS``)."""
+        return {}

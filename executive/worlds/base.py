@@ -1,0 +1,146 @@
+"""The world backend seam: what the mission runner asks of a kind of world.
+
+A backend builds its world from a scenario's ``world:`` mapping, makes the robots
+and the radio, senses each step, measures coverage and adds its figures and its map
+to the outputs. The runner holds one backend and never asks which kind it is.
+
+A backend registers itself with :func:`delve.executive.worlds.register_world`; a
+scenario's ``world:`` mapping picks the first backend that :meth:`claims` it.
+"""
+from __future__ import annotations
+
+import inspect
+from abc import ABC, abstractmethod
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, ClassVar, Mapping
+
+import numpy as np
+
+from ..errors import DelveError, did_you_mean
+from ..yamlio import YamlDict
+
+if TYPE_CHECKING:
+    from ...skills.base import AgentContext
+    from ...sim.clock import SimClock
+    from ..runner import Mission
+    from ..scenario import Scenario
+
+#: The base station's agent and radio name.
+BASE = "base"
+
+
+@dataclass(frozen=True)
+class Coverage:
+    """Explored fractions at one moment: the team's, the base station's, each robot's."""
+
+    team: float
+    base: float
+    robots: dict[str, float]
+
+
+@dataclass(frozen=True)
+class TeamNetwork:
+    """The mobility-communication network a team starts on (for planned
+    communication): each robot's ``NetworkView``, each robot's start location, the
+    base station's location and the topology known at the start."""
+
+    views: dict[str, Any]
+    team: dict[str, str]
+    base_location: str
+    initial_topology: dict[str, Any]
+
+
+class WorldBackend(ABC):
+    """One kind of world, made runnable for one mission.
+
+    An instance holds ``world``, ``robots`` (name -> robot implementing the robot
+    interface, plus ``step``, ``park``, ``jam`` and ``kill``), ``radio`` (its
+    ``endpoints``, ``update()`` and ``linked(a, b)``) and ``base_position``.
+    """
+
+    #: The ``world:`` keys that make a scenario's world this backend's.
+    KEYS: ClassVar[tuple[str, ...]] = ()
+    #: What the coverage plot's fraction counts.
+    COVERAGE_LABEL: ClassVar[str] = "fraction explored"
+    #: Fault kinds this world cannot inject (``faults:`` in a scenario).
+    UNSUPPORTED_FAULTS: ClassVar[tuple[str, ...]] = ()
+
+    world: Any
+    robots: dict[str, Any]
+    radio: Any
+    base_position: np.ndarray
+
+    # ---- scenario time ------------------------------------------------------------
+    @classmethod
+    @abstractmethod
+    def claims(cls, world: Mapping[str, Any]) -> bool:
+        """Whether a scenario's ``world:`` mapping describes a world of this kind."""
+
+    @classmethod
+    @abstractmethod
+    def generators(cls) -> dict[str, Any]:
+        """The world generators of this kind by name (their keyword parameters are
+        the ``world:`` keys a scenario may give with them)."""
+
+    @classmethod
+    def check(cls, doc: YamlDict, path: Path, has_base_tree: bool) -> None:
+        """Check what the scenario ``doc`` asks of this world (its ``world:``
+        parameters, ``radio:`` keys, base station); a :class:`DelveError` if wrong."""
+        world = doc["world"]
+        if "generator" in world:
+            params = inspect.signature(cls.generators()[world["generator"]]).parameters
+            only_keys(world, ("generator", *params), "world: unknown parameter", path)
+        for i, fault in enumerate(doc.get("faults", [])):
+            if fault["kind"] in cls.UNSUPPORTED_FAULTS:
+                raise DelveError(f"a {fault['kind']!r} fault does not apply to this world", path,
+                                 doc["faults"].item_line(i))
+
+    @classmethod
+    @abstractmethod
+    def build_world(cls, scenario: "Scenario", seed: int) -> Any:
+        """Generate or load the world; a :class:`DelveError` when its parameters are
+        wrong. A generator without its own ``seed`` takes ``seed``."""
+
+    # ---- a mission ----------------------------------------------------------------
+    @abstractmethod
+    def __init__(self, scenario: "Scenario", world: Any, seed: int, clock: "SimClock"):
+        """Make the radio, the robots of ``scenario`` and the base station's radio."""
+
+    @abstractmethod
+    def base_services(self) -> dict[str, Any]:
+        """The base station agent's services: at least its ``radio``."""
+
+    def sense(self, now_s: float) -> None:
+        """Run the robots' sensors that are due at ``now_s``."""
+
+    @abstractmethod
+    def coverage(self, explored_at_base: set[str]) -> Coverage:
+        """Explored fractions now. ``explored_at_base``: locations the team strategy
+        says the base station knows to be explored (worlds of locations count them)."""
+
+    def network(self, contexts: dict[str, AgentContext], cell_m: float) -> TeamNetwork:
+        """The team's start on a mobility-communication network (for planned
+        communication): ``contexts`` are the robots' agent contexts, ``cell_m`` the
+        size of a location where the world must cut its space into locations. Worlds
+        that cannot give one raise a :class:`DelveError`."""
+        raise DelveError(f"this world ({type(self).__name__}) has no mobility-communication network")
+
+    def figures(self, mission: "Mission") -> dict[str, Any]:
+        """The report's figures of this world (before the team strategy's)."""
+        return {}
+
+    def robot_figures(self, name: str, lost: set[str]) -> dict[str, Any]:
+        """The report's extra figures of robot ``name``."""
+        return {}
+
+    @abstractmethod
+    def plot_map(self, mission: "Mission", path: Path) -> None:
+        """Write the top-down map of the run to ``path`` (PNG)."""
+
+
+def only_keys(mapping: YamlDict, allowed: tuple[str, ...], what: str, path: Path) -> None:
+    """A :class:`DelveError` at the first key of ``mapping`` not in ``allowed``."""
+    for key in mapping:
+        if key not in allowed:
+            raise DelveError(f"{what} {key!r}{did_you_mean(key, allowed)}", path, mapping.key_line(key))

@@ -1,0 +1,171 @@
+"""Voxel worlds (procedural generators and meshes): robots with LiDAR and onboard
+voxel maps, a radio with path loss and breadcrumbs, coverage of the free volume."""
+from __future__ import annotations
+
+from dataclasses import replace
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Mapping
+
+import numpy as np
+
+from ...planners.cops.topology import Topology
+from ...sim import worldgen
+from ...sim.clock import SimClock
+from ...sim.platforms import PLATFORMS
+from ...sim.radio import RadioNetwork, RadioSpec
+from ...sim.robot import SimRobot
+from ...sim.voxel_map import VoxelMap
+from ...sim.world import World
+from ...skills.base import AgentContext
+from ...skills.cops_voxel import VoxelNetworkView
+from ...skills.navigation import navigator
+from ..errors import DelveError
+from ..yamlio import YamlDict
+from .base import BASE, Coverage, TeamNetwork, WorldBackend, only_keys
+from .voxel_plot import plot_voxel_map
+
+if TYPE_CHECKING:
+    from ..runner import Mission
+    from ..scenario import RobotSpec, Scenario
+
+#: What a ``world: {mesh: ...}`` mapping may hold besides the file.
+MESH_OPTIONS = ("mesh", "scale", "up_axis", "voxel_size_m", "start", "seed")
+#: Where robots without a ``start`` stand, around the world's start (m), in order.
+START_OFFSETS_M = [(0, 0), (1.2, 0), (-1.2, 0), (0, 1.2), (0, -1.2), (2.4, 0), (-2.4, 0), (2.4, 1.2),
+                   (-2.4, 1.2), (2.4, -1.2), (-2.4, -1.2), (3.6, 0), (-3.6, 0)]
+
+
+class VoxelBackend(WorldBackend):
+    """A voxel world: ``world: {generator: tunnel_network | cave, ...}`` or
+    ``world: {mesh: FILE, ...}``. Coverage is the fraction of the free volume
+    reachable from the first robot's start that the robots' LiDARs observed; the
+    base station knows what reached its map (service ``map``)."""
+
+    KEYS = ("generator", "mesh")
+    COVERAGE_LABEL = "fraction of free volume observed"
+
+    @classmethod
+    def generators(cls) -> dict[str, Any]:
+        return {"tunnel_network": worldgen.tunnel_network, "cave": worldgen.cave}
+
+    @classmethod
+    def claims(cls, world: Mapping[str, Any]) -> bool:
+        return "mesh" in world or world.get("generator") in cls.generators()
+
+    @classmethod
+    def check(cls, doc: YamlDict, path: Path, has_base_tree: bool) -> None:
+        if "mesh" in doc["world"]:
+            only_keys(doc["world"], MESH_OPTIONS, "world: unknown parameter", path)
+        super().check(doc, path, has_base_tree)
+
+    @classmethod
+    def build_world(cls, scenario: "Scenario", seed: int) -> World:
+        spec, where = dict(scenario.world), scenario.doc["world"]
+        try:
+            if "mesh" in spec:
+                mesh = (scenario.path.parent / spec.pop("mesh")).resolve()
+                if not mesh.exists():
+                    raise DelveError(f"mesh file not found: {mesh}", scenario.path, where.key_line("mesh"))
+                spec.pop("seed", None)
+                return worldgen.from_mesh(mesh, **spec)
+            generate = cls.generators()[spec.pop("generator")]
+            spec.setdefault("seed", seed)
+            return generate(**spec)
+        except ValueError as err:
+            raise DelveError(f"world: {err}", scenario.path, where.line) from None
+
+    # ---- a mission ----------------------------------------------------------------
+    def __init__(self, scenario: "Scenario", world: World, seed: int, clock: SimClock):
+        self.scenario, self.world = scenario, world
+        self.radio = RadioNetwork(RadioSpec(**scenario.radio), world, np.random.default_rng(seed),
+                                  lambda: clock.now_s)
+        self.robots: dict[str, SimRobot] = {}
+        self._next_scan: dict[str, float] = {}
+        for i, spec in enumerate(scenario.robots):
+            self.robots[spec.name] = self._robot(spec, i)
+            self._next_scan[spec.name] = 0.0
+        base_pos = np.asarray(scenario.base_position if scenario.base_position is not None
+                              else world.start + np.array([0.0, 0.0, 1.0]), dtype=float)
+        self.base_position = base_pos
+        self.base_map = VoxelMap(world.free.shape, world.origin, world.voxel_size_m)
+        self._base_radio = self.radio.add(BASE, lambda: base_pos, breadcrumbs=0)
+        reach = world.reachable_free(self.first_start())
+        #: Flat indices of the free voxels the team should explore (ground truth).
+        self.truth = np.flatnonzero(reach.reshape(-1))
+
+    def _robot(self, spec: "RobotSpec", index: int) -> SimRobot:
+        base = PLATFORMS[spec.platform]
+        platform = replace(base, **spec.overrides, lidar=replace(base.lidar, **spec.lidar))
+        start = np.asarray(spec.start, float) if spec.start is not None else self._free_start(index)
+        holder: dict[str, SimRobot] = {}
+        radio = self.radio.add(spec.name, lambda: holder["r"].position, breadcrumbs=spec.breadcrumbs)
+        robot = SimRobot(spec.name, platform, self.world, start, radio, spec.endurance_s)
+        holder["r"] = robot
+        return robot
+
+    def _free_start(self, index: int) -> np.ndarray:
+        """A start on the floor near the world's start, a little apart for each robot."""
+        free = [np.asarray(self.world.start) + np.array([dx, dy, 0.0]) for dx, dy in START_OFFSETS_M]
+        free = [p for p in free if self.world.start_problem(p + np.array([0, 0, 0.3])) is None]
+        if index >= len(free):
+            raise DelveError(f"no free start pose near the world's start for robot #{index + 1}",
+                             self.scenario.path, self.scenario.robots[index].line)
+        return free[index]
+
+    def first_start(self) -> np.ndarray:
+        """The ground point under the first robot's start."""
+        r = next(iter(self.robots.values()))
+        return r.home - np.array([0.0, 0.0, r.mobility.body_height_m])
+
+    def base_services(self) -> dict[str, Any]:
+        return {"radio": self._base_radio, "map": self.base_map}
+
+    def sense(self, now_s: float) -> None:
+        for name, robot in self.robots.items():
+            if robot.alive and now_s + 1e-9 >= self._next_scan[name]:
+                self._scan(name, now_s)
+
+    def _scan(self, name: str, now_s: float) -> None:
+        robot = self.robots[name]
+        robot.scan()
+        self._next_scan[name] = now_s + 1.0 / robot.mobility.lidar.rate_hz
+
+    def coverage(self, explored_at_base: set[str]) -> Coverage:
+        team = np.zeros(len(self.truth), dtype=bool)
+        per_robot = {}
+        for name, robot in self.robots.items():
+            seen = robot.onboard_map.occupancy.reshape(-1)[self.truth] == 0
+            per_robot[name] = round(float(seen.mean()) if len(seen) else 0.0, 5)
+            team |= seen
+        return Coverage(team=round(float(team.mean()) if len(team) else 0.0, 5),
+                        base=round(self.base_map.known_fraction_of(self.truth), 5), robots=per_robot)
+
+    def network(self, contexts: dict[str, AgentContext], cell_m: float) -> TeamNetwork:
+        """Every robot's network view uses one lattice, with a cell centred on the first
+        robot's start, and the radio's range; each robot's start location and the
+        initial topology come from its first scan, taken here, at the base, where all
+        robots hear it."""
+        corner = self.first_start() - 0.5 * cell_m
+        initial, team, views = Topology(), {}, {}
+        for name, robot in self.robots.items():
+            view = VoxelNetworkView(robot, cell_m=cell_m, lattice_origin=corner, comm_range_m=self.radio.spec.range_m,
+                                    navigator=navigator(contexts[name], robot))
+            views[name] = view
+            self._scan(name, 0.0)
+            initial.merge(view.current())
+            team[name] = view.location()
+            if team[name] is None:
+                spec = next(s for s in self.scenario.robots if s.name == name)
+                raise DelveError(f"robot '{name}' does not stand in a location of the COPS network "
+                                 f"at its start", self.scenario.path, spec.line)
+        base_location = view.cell_of(self.first_start()[None])[0]
+        return TeamNetwork(views, team, base_location, initial.to_dict())
+
+    def figures(self, mission: "Mission") -> dict[str, Any]:
+        return {"free_volume_m3": round(len(self.truth) * self.world.voxel_size_m ** 3, 1)}
+
+    def robot_figures(self, name: str, lost: set[str]) -> dict[str, Any]:
+        return {"lost": name in lost} if lost else {}
+
+    def plot_map(self, mission: "Mission", path: Path) -> None:
+        plot_voxel_map(mission, self.truth, path)

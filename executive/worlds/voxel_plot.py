@@ -1,0 +1,61 @@
+"""The top-down map of a run on a voxel world (``map.png``)."""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from ...planners.frontier import frontier_voxels  # noqa: E402
+from ...planners.occupancy import Grid  # noqa: E402
+
+if TYPE_CHECKING:
+    from ..runner import Mission
+
+
+def _top_down(mask: np.ndarray) -> np.ndarray:
+    return mask.any(axis=2).T
+
+
+def plot_voxel_map(mission: "Mission", truth_voxels: np.ndarray, path: Path) -> None:
+    """Top-down map: free space, what the team saw, walls, paths, frontiers, radio links."""
+    world = mission.world
+    extent = (world.origin[0], world.origin[0] + world.free.shape[0] * world.voxel_size_m,
+              world.origin[1], world.origin[1] + world.free.shape[1] * world.voxel_size_m)
+    fig, ax = plt.subplots(figsize=(9, 9 * (extent[3] - extent[2]) / max(extent[1] - extent[0], 1e-6) + 0.8))
+    truth = np.zeros(world.free.size, dtype=bool)
+    truth[truth_voxels] = True
+    seen = np.zeros(world.free.shape, dtype=bool)
+    walls = np.zeros(world.free.shape, dtype=bool)
+    for robot in mission.robots.values():
+        seen |= robot.onboard_map.occupancy == 0
+        walls |= robot.onboard_map.occupancy == 1
+    img = np.ones(world.free.shape[:2][::-1] + (3,))
+    img[_top_down(truth.reshape(world.free.shape))] = (0.85, 0.85, 0.85)
+    img[_top_down(seen)] = (0.72, 0.84, 0.95)
+    img[_top_down(walls) & ~_top_down(seen)] = (0.35, 0.35, 0.35)
+    ax.imshow(img, origin="lower", extent=extent, interpolation="nearest")
+    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    for i, (name, robot) in enumerate(mission.robots.items()):
+        trail = robot.traversed_path
+        ax.plot(trail[:, 0], trail[:, 1], "-", lw=1.3, color=colours[i % len(colours)], label=f"{name} path")
+        m = robot.onboard_map
+        front = frontier_voxels(Grid(m.occupancy, m.origin, m.voxel_size_m))
+        if len(front):
+            pts = m.origin + (np.stack(np.unravel_index(front[::5], m.shape), axis=1) + 0.5) * m.voxel_size_m
+            ax.plot(pts[:, 0], pts[:, 1], ".", ms=1.5, color="red", label=f"{name} frontiers" if i == 0 else None)
+        pos = np.array([s.positions[name] for s in mission.state.samples])
+        linked = np.array([s.linked[name] for s in mission.state.samples])
+        ax.plot(pos[linked, 0], pos[linked, 1], "o", ms=3, color="green", label="radio link to base" if i == 0 else None)
+    ax.plot(*mission.base_position[:2], "k^", ms=9, label="base station")
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    ax.set_title(f"{mission.scenario.name}: team coverage {mission.state.samples[-1].team:.0%}")
+    ax.legend(loc="upper right", fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)

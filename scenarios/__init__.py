@@ -1,0 +1,1 @@
+"""The shipped scenarios and their worlds (YAML, meshes), installed as package data."""

@@ -1,0 +1,1 @@
+"""The shipped mission trees and subtrees (YAML), installed as package data."""
