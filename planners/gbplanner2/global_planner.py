@@ -35,12 +35,13 @@ import networkx as nx
 import numpy as np
 from scipy.spatial import cKDTree
 
+from ..geometry import path_length
 from ..occupancy import OCCUPIED, Grid
 from .config import GBPlannerConfig
 from .gain import ring_azimuth, volumetric_gain
 from .local_map import LocalMap
 from .local_planner import LocalPlanResult
-from .path_improvement import path_length, shortcut_path
+from .path_improvement import shortcut_path
 
 
 @dataclass

@@ -24,6 +24,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -216,6 +217,38 @@ class LocalPlanner:
             vertex_path=vpath,
             **extra,
         )
+
+
+class ShrinkingLocalPlanner(LocalPlanner):
+    """The local planner, re-run in a smaller local bounding box when the adaptive box
+    gave a local graph of (almost) no vertices.
+
+    The adaptive box spans the PCA of all mapped points within mu_V (50 m); where the
+    robot stands in a narrow passage next to a wider network (a ramp up from a
+    junction, say), the box is mostly rock and unknown space, and graph building stops
+    after its first batch of samples because so few were free. Halving the box (down
+    to ``bounding_box_size_min_m``) keeps its orientation and fills it with vertices.
+    """
+
+    #: A graph with fewer vertices than this is re-built in a smaller box.
+    min_vertices = 10
+    #: At most this many halvings.
+    max_shrinks = 2
+
+    def plan(self, grid: Grid, position: np.ndarray, rng: np.random.Generator, *,
+             bound: LocalBound | None = None, **kw: Any) -> LocalPlanResult:
+        res = super().plan(grid, position, rng, bound=bound, **kw)
+        size_min = 0.5 * np.sort(np.asarray(self.config.bounding_box_size_min_m, float))[::-1]
+        for _ in range(self.max_shrinks):
+            g = res.graph
+            if bound is not None or g is None or g.bound is None or g.num_vertices >= self.min_vertices:
+                break
+            b = g.bound
+            half = np.maximum(0.5 * b.half_extents_m, size_min)
+            if np.allclose(half, b.half_extents_m):
+                break
+            res = super().plan(grid, position, rng, bound=LocalBound(b.centre, b.axes, half, b.num_points), **kw)
+        return res
 
 
 def _select_best(graph: LocalGraph, paths: ShortestPaths, pg: PathGains) -> tuple[int, list[int]]:

@@ -25,11 +25,6 @@ from .config import GBPlannerConfig
 from .local_map import GROUND_ATTACHED, LocalMap
 
 
-def path_length(path: np.ndarray) -> float:
-    p = np.asarray(path, float)
-    return float(np.linalg.norm(np.diff(p, axis=0), axis=1).sum()) if len(p) > 1 else 0.0
-
-
 def segments_admissible(local_map: LocalMap, path: np.ndarray) -> np.ndarray:
     """Admissibility of each segment of ``path``."""
     p = np.asarray(path, float)

@@ -6,7 +6,8 @@ from delve.planners.gbplanner2.config import GBPlannerConfig
 from delve.planners.gbplanner2.global_planner import GlobalPlanner
 from delve.planners.gbplanner2.local_map import LocalMap
 from delve.planners.gbplanner2.local_planner import LocalPlanner, LocalPlanResult, PlanDiagnostics
-from delve.planners.gbplanner2.path_improvement import path_length, segments_admissible
+from delve.planners.gbplanner2.path_improvement import segments_admissible
+from delve.planners.geometry import path_length
 from delve.planners.occupancy import OCCUPIED, Grid
 
 CFG = GBPlannerConfig.anymal_c(num_vertices_max=200, num_edges_max=3000, low_gain_iterations_max=3)

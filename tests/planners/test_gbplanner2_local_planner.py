@@ -5,7 +5,8 @@ from delve.planners.gbplanner2 import synthetic as s
 from delve.planners.gbplanner2.config import GBPlannerConfig
 from delve.planners.gbplanner2.local_map import LocalMap
 from delve.planners.gbplanner2.local_planner import LocalPlanner
-from delve.planners.gbplanner2.path_improvement import path_length, segments_admissible
+from delve.planners.gbplanner2.path_improvement import segments_admissible
+from delve.planners.geometry import path_length
 from delve.planners.occupancy import OCCUPIED, UNKNOWN, Grid
 
 LEGGED = GBPlannerConfig.anymal_c(num_vertices_max=250, num_edges_max=4000)
@@ -109,3 +110,24 @@ def test_unseen_ground_right_under_a_legged_robot_counts_as_ground():
     assert ok.ok, ok.reason
     strict = LocalPlanner(LEGGED.replace(assumed_ground_radius_m=0.0)).plan(blind, p, np.random.default_rng(0))
     assert not strict.ok
+
+
+def test_shrinking_local_planner_refills_a_graph_starved_box(monkeypatch):
+    """A 2 m wide tunnel in a wide, mostly rock and unknown local box: graph building
+    stops after its first batch of samples, and the smaller box fills with vertices."""
+    import delve.planners.gbplanner2.local_planner as lp
+    from delve.planners.gbplanner2 import LocalBound
+
+    grid, a, _ = s.straight_tunnel(length_m=40, width_m=2.0)
+    p = np.asarray(a, float) + np.array([10.0, 0.0, 0.5])
+    # ANYmal C fitted to a 0.4 m radius robot on 0.2 m voxels (as the Explore skill fits it).
+    cfg = GBPlannerConfig.preset("legged").with_robot_limits(
+        speed_mps=1.0, body_height_m=0.5, radius_m=0.3, max_inclination_deg=35.0, max_step_m=0.3,
+        endurance_s=3000.0).replace(num_vertices_max=150, num_edges_max=2500)
+    huge = LocalBound(p, np.eye(3), np.array([17.5, 17.5, 8.0]))
+    monkeypatch.setattr(lp, "adaptive_local_bound", lambda *args, **kwargs: huge)
+    starved = lp.LocalPlanner(cfg).plan(grid, p, np.random.default_rng(0))
+    assert starved.graph.num_vertices < lp.ShrinkingLocalPlanner.min_vertices
+    res = lp.ShrinkingLocalPlanner(cfg).plan(grid, p, np.random.default_rng(0))
+    assert res.graph.num_vertices >= lp.ShrinkingLocalPlanner.min_vertices
+    assert np.all(res.graph.bound.half_extents_m < huge.half_extents_m)

@@ -1,12 +1,12 @@
 """ImprovePath: shortcuts and pushing away from obstacles, always admissible."""
 import numpy as np
 import pytest
+from delve.planners.geometry import path_length
 from delve.planners.gbplanner2 import synthetic as s
 from delve.planners.gbplanner2.config import GBPlannerConfig
 from delve.planners.gbplanner2.local_map import LocalMap
 from delve.planners.gbplanner2.path_improvement import (
     improve_path,
-    path_length,
     push_away_from_obstacles,
     segments_admissible,
     shortcut_path,
