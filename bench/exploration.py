@@ -2,10 +2,11 @@
 
 The same legged robot (ANYmal-like, 1800 s endurance) explores each generated world
 twice, once with ``trees/gbplanner_explorer.yaml`` (GBPlanner2's Explore and Home) and
-once with ``trees/frontier_explorer.yaml`` (nearest frontier, ReturnHome), on the same
-world and seed. T90 is the sim time at which the robot has observed 90 % of the
-world's reachable free volume (linearly interpolated between coverage samples, every
-5 s); "not reached" when it never does, with the final coverage.
+once with ``trees/frontier_explorer.yaml`` (nearest frontier, Home along the navigation
+graph), on the same world and seed. T90 is the sim time at which the robot has
+observed 90 % of the world's reachable free volume (linearly interpolated between
+coverage samples, every 5 s); "not reached" when it never does, with the final
+coverage.
 
 Worlds: a tunnel network, a two-level tunnel network joined by a ramp, and a cave
 (no shaft: the legged robot must be able to reach all of it), each with several

@@ -12,14 +12,16 @@ re-exported here for importers of this module.
 """
 from __future__ import annotations
 
+import sys
 from collections.abc import Iterable, Iterator, Mapping
+from typing import Any
 
 from py_trees.behaviour import Behaviour
 
 from ..skills import all_skills
 from ..skills.base import Skill
 from .builtin_nodes import BUILTINS
-from .errors import did_you_mean
+from .errors import DelveError, did_you_mean
 from .node_types import KINDS, RESERVED_KEYS, Build, Builder, NodeType, Site, coerce_param, first_paragraph
 
 __all__ = [
@@ -83,13 +85,38 @@ def _skill_builder(cls: type[Skill]) -> Builder:
     return build
 
 
+_deprecations_told: set[tuple[str | None, int | None, str]] = set()
+
+
+def _alias_builder(cls: type[Skill], alias: str, name: str, fixed: Mapping[str, Any]) -> Builder:
+    """Builds ``cls`` with the parameters ``fixed`` on top, after telling (on stderr, once
+    per place in a file) that ``alias`` is deprecated and what to write instead."""
+    instead = ", ".join([f"type: {name}", *(f"{k}: {v}" for k, v in fixed.items())])
+
+    def build(b: Build) -> Behaviour:
+        if (b.site.file, b.site.line, alias) not in _deprecations_told:
+            _deprecations_told.add((b.site.file, b.site.line, alias))
+            notice = DelveError(f"type {alias!r} is deprecated: write {instead}", b.site.file, b.site.line)
+            print(f"{notice}", file=sys.stderr)
+        return cls(name=b.name, ctx=b.ctx, remap=b.remap, **{**b.params, **fixed})
+
+    return build
+
+
 def skill_types(skills: Mapping[str, type[Skill]] | None = None) -> list[NodeType]:
-    """Node types for ``skills`` (default: :func:`delve.skills.all_skills`)."""
+    """Node types for ``skills`` (default: :func:`delve.skills.all_skills`), and for the
+    former names a skill class keeps in ``ALIASES`` (old name -> the parameters it
+    stands for; built with a deprecation notice)."""
     skills = all_skills() if skills is None else skills
-    return [
-        NodeType(name, "skill", _skill_builder(cls), dict(cls.PARAMS), first_paragraph(cls), "none", cls=cls)
-        for name, cls in sorted(skills.items())
-    ]
+    types = []
+    for name, cls in sorted(skills.items()):
+        types.append(NodeType(name, "skill", _skill_builder(cls), dict(cls.PARAMS), first_paragraph(cls), "none",
+                              cls=cls))
+        for alias, fixed in sorted(cls.__dict__.get("ALIASES", {}).items()):
+            params = {k: v for k, v in cls.PARAMS.items() if k not in fixed}
+            doc = f"Deprecated: write {name} with " + ", ".join(f"{k}: {v}" for k, v in fixed.items()) + "."
+            types.append(NodeType(alias, "skill", _alias_builder(cls, alias, name, fixed), params, doc, "none"))
+    return types
 
 
 _cache: tuple[tuple[tuple[str, type], ...], Registry] | None = None

@@ -7,6 +7,7 @@ import numpy as np
 from py_trees.common import Status
 
 from ..planners.frontier import FrontierCluster, FrontierGoal, frontier_clusters, frontier_voxels, nearest_frontier
+from ..planners.geometry import xyz
 from .base import Param, Skill
 from .navigation import Plan, navigator
 from .robot import PathStatus
@@ -85,13 +86,13 @@ float, 2.0, "how often the target cluster is re-checked", exclusive_minimum=0),
                 self._blacklist("still a frontier after a visit")
             return True
         if status == PathStatus.BLOCKED:
-            self._blacklist(f"path blocked: {getattr(self.robot, 'blocked_reason', '')}")
+            self._blacklist(f"path blocked: {self.robot.blocked_reason}")
         return True
 
     def _blacklist(self, reason: str) -> None:
         assert self.goal is not None
         self.blacklist = np.union1d(self.blacklist, self.goal.cluster.voxels)
-        self.event("frontier_blacklisted", at=_xyz(self.goal.cluster.centroid), reason=reason)
+        self.event("frontier_blacklisted", at=xyz(self.goal.cluster.centroid), reason=reason)
 
     def _plan(self) -> Status:
         self.goal, self.arrived_s = None, None
@@ -119,9 +120,9 @@ float, 2.0, "how often the target cluster is re-checked", exclusive_minimum=0),
             return Status.SUCCESS
         self.goal, self.checked_s = goal, self.ctx.clock.now_s
         self.follow(plan.path_to(goal.node))
-        self.bb.set(self.k_goal, _xyz(plan.graph.positions[goal.node]))
+        self.bb.set(self.k_goal, xyz(plan.graph.positions[goal.node]))
         self.feedback_message = f"to frontier {goal.path_length_m:.1f} m away"
-        self.event("frontier_goal", at=_xyz(goal.cluster.centroid), path_length_m=round(goal.path_length_m, 2),
+        self.event("frontier_goal", at=xyz(goal.cluster.centroid), path_length_m=round(goal.path_length_m, 2),
                    clusters=len(clusters))
         return Status.RUNNING
 
@@ -138,10 +139,6 @@ float, 2.0, "how often the target cluster is re-checked", exclusive_minimum=0),
                 self._blacklist("unobservable from its goal")
             # Otherwise the graph does not reach any nearer: skip it on this graph.
             clusters = [c for c in clusters if c is not goal.cluster]
-
-
-def _xyz(p: np.ndarray) -> list[float]:
-    return [round(float(v), 3) for v in p]
 
 
 __all__ = ["ExploreFrontiers"]

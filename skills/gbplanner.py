@@ -1,10 +1,12 @@
-"""GBPlanner2 skills: exploration with the local/global planner, and homing along its
-global graph (Kulkarni et al. 2022, section IV-A; CERBERUS SubT Final, section 3.3.1).
+"""GBPlanner2 skills: exploration with the local/global planner (Kulkarni et al. 2022,
+section IV-A; CERBERUS SubT Final, section 3.3.1), and the agent's shared planner.
 
 One :class:`~delve.planners.gbplanner2.GBPlanner` per robot lives in the agent's
-``ctx.services`` (see :func:`gbplanner`), so that ``Explore``, ``Home`` and
-``GoTo`` (``planner: gbplanner``) share one global graph: the frontiers the local
-planner leaves behind, the visited positions, and the way home.
+``ctx.services`` (see :func:`gbplanner`), so that ``Explore``, ``Home``
+(``path_source: gbplanner2``), ``GoTo`` (``planner: gbplanner``) and ``Relocate``
+share one global graph: the frontiers the local planner leaves behind, the visited
+positions, and the way home. What the planner is given of the onboard map is made in
+:mod:`delve.planners.gbplanner2.planning_map`.
 """
 from __future__ import annotations
 
@@ -15,17 +17,11 @@ from typing import Any
 import numpy as np
 from py_trees.common import Access, Status
 
-from ..planners.gbplanner2 import (
-    Frontier,
-    GBPlanner,
-    GBPlannerConfig,
-    LocalBound,
-    LocalMap,
-    LocalPlanner,
-    LocalPlanResult,
-    PlanResult,
-)
-from ..planners.occupancy import FREE, OCCUPIED, UNKNOWN, Grid
+from ..planners.gbplanner2 import Frontier, GBPlanner, GBPlannerConfig, PlanResult
+from ..planners.gbplanner2.local_planner import ShrinkingLocalPlanner
+from ..planners.gbplanner2.planning_map import blocked_spot, mark_blocked_spots, sealed_grid, start_pose
+from ..planners.geometry import path_length, xyz
+from ..planners.occupancy import Grid
 from .base import AgentContext, Param, Skill
 from .navigation import navigator
 from .robot import PathStatus, Robot
@@ -46,38 +42,6 @@ class PlannerService:
     #: Where the robot's paths were blocked although its map showed a way (body-centre
     #: points just ahead of it): the planner sees rock there from then on.
     blocked_spots: list[np.ndarray] = field(default_factory=list)
-
-
-class ShrinkingLocalPlanner(LocalPlanner):
-    """The local planner, re-run in a smaller local bounding box when the adaptive box
-    gave a local graph of (almost) no vertices.
-
-    The adaptive box spans the PCA of all mapped points within mu_V (50 m); where the
-    robot stands in a narrow passage next to a wider network (a ramp up from a
-    junction, say), the box is mostly rock and unknown space, and graph building stops
-    after its first batch of samples because so few were free. Halving the box (down
-    to ``bounding_box_size_min_m``) keeps its orientation and fills it with vertices.
-    """
-
-    #: A graph with fewer vertices than this is re-built in a smaller box.
-    min_vertices = 10
-    #: At most this many halvings.
-    max_shrinks = 2
-
-    def plan(self, grid: Grid, position: np.ndarray, rng: np.random.Generator, *,
-             bound: LocalBound | None = None, **kw: Any) -> LocalPlanResult:
-        res = super().plan(grid, position, rng, bound=bound, **kw)
-        size_min = 0.5 * np.sort(np.asarray(self.config.bounding_box_size_min_m, float))[::-1]
-        for _ in range(self.max_shrinks):
-            g = res.graph
-            if bound is not None or g is None or g.bound is None or g.num_vertices >= self.min_vertices:
-                break
-            b = g.bound
-            half = np.maximum(0.5 * b.half_extents_m, size_min)
-            if np.allclose(half, b.half_extents_m):
-                break
-            res = super().plan(grid, position, rng, bound=LocalBound(b.centre, b.axes, half, b.num_points), **kw)
-        return res
 
 
 def robot_config(robot: Robot, overrides: dict[str, Any] | None = None) -> GBPlannerConfig:
@@ -135,92 +99,6 @@ def onboard_grid(ctx: AgentContext, robot: Robot) -> Grid:
     return navigator(ctx, robot).grid()
 
 
-def sealed_grid(grid: Grid) -> Grid:
-    """A copy of ``grid`` in which UNKNOWN voxels that share a face with an OCCUPIED one
-    are OCCUPIED: the mapped rock surface, one voxel thick, has gaps where the LiDAR's
-    returns fell on a neighbouring voxel, and the planner's gain rays (one voxel per
-    step) slip through them into the unknown rock behind, which then looks like
-    hundreds of m3 of unexplored space forever. Openings wider than two voxels stay
-    open, so real frontiers keep their gain."""
-    occ = grid.occupancy
-    rock = occ == OCCUPIED
-    near = np.zeros_like(rock)
-    for ax in range(3):
-        lo = [slice(None)] * 3
-        hi = [slice(None)] * 3
-        lo[ax], hi[ax] = slice(None, -1), slice(1, None)
-        near[tuple(lo)] |= rock[tuple(hi)]
-        near[tuple(hi)] |= rock[tuple(lo)]
-    out = occ.copy()
-    out[near & (occ == UNKNOWN)] = OCCUPIED
-    return Grid(out, grid.origin, grid.voxel_size_m, grid.free)
-
-
-def mark_blocked_spots(grid: Grid, spots: list[np.ndarray], radius_m: float, below_m: float) -> Grid:
-    """A copy of ``grid`` with rock at each spot: every voxel within ``radius_m``
-    horizontally, from ``below_m`` under the spot to ``radius_m`` above it."""
-    if not spots or radius_m <= 0:
-        return grid
-    occ = grid.occupancy.copy()
-    vs = grid.voxel_size_m
-    r = radius_m / vs
-    for p in spots:
-        lo = grid.to_index(np.array([[p[0] - radius_m, p[1] - radius_m, p[2] - below_m]]))[0]
-        hi = grid.to_index(np.array([[p[0] + radius_m, p[1] + radius_m, p[2] + radius_m]]))[0] + 1
-        lo, hi = np.maximum(lo, 0), np.minimum(hi, np.array(occ.shape))
-        if np.any(hi <= lo):
-            continue
-        c = grid.to_index(np.asarray(p, float)[None])[0]
-        ii, jj = np.meshgrid(np.arange(lo[0], hi[0]), np.arange(lo[1], hi[1]), indexing="ij")
-        disc = (ii - c[0]) ** 2 + (jj - c[1]) ** 2 <= r * r
-        occ[lo[0]:hi[0], lo[1]:hi[1], lo[2]:hi[2]][disc] = OCCUPIED
-    return Grid(occ, grid.origin, grid.voxel_size_m, None)
-
-
-def blocked_spot(position: np.ndarray, path: np.ndarray | None, ahead_m: float) -> np.ndarray | None:
-    """The point ``ahead_m`` in front of ``position`` (horizontally) towards where
-    ``path`` went on from the segment nearest to it; None without a direction."""
-    if path is None or len(path) == 0:
-        return None
-    pts = np.vstack([position, path]) if len(path) == 1 else path
-    a, b = pts[:-1], pts[1:]
-    ab = b - a
-    t = np.clip(np.einsum("ij,ij->i", position - a, ab) / np.maximum(np.einsum("ij,ij->i", ab, ab), 1e-12), 0, 1)
-    k = int(np.argmin(np.linalg.norm(a + t[:, None] * ab - position, axis=1)))
-    for q in pts[k + 1:]:
-        d = (q - position)[:2]
-        n = float(np.hypot(d[0], d[1]))
-        if n > 0.05:
-            return np.array([position[0] + d[0] / n * ahead_m, position[1] + d[1] / n * ahead_m, position[2]])
-    return None
-
-
-def start_pose(grid: Grid, config: GBPlannerConfig, position: np.ndarray, max_shift_m: float) -> np.ndarray:
-    """Where the planner starts: the robot's position or, when the robot box there
-    touches mapped rock (the robot stands close to a wall or on a sloping floor, and
-    the box is rounded up to whole voxels), the nearest point at most
-    ``max_shift_m`` away (sideways, or up) whose box is clear; the position itself
-    when there is none."""
-    position = np.asarray(position, float)
-    if max_shift_m <= 0:
-        return position
-    lm = LocalMap(grid, position - max_shift_m - 1.0, position + max_shift_m + 1.0, config)
-    if not lm.box_has_occupied(position):
-        return position
-    vs = grid.voxel_size_m
-    n = int(max_shift_m // vs + 1e-9)
-    steps = np.arange(-n, n + 1) * vs
-    dx, dy, dz = np.meshgrid(steps, steps, steps[steps >= 0], indexing="ij")
-    shifts = np.stack([dx.ravel(), dy.ravel(), dz.ravel()], axis=1)
-    shifts = shifts[np.linalg.norm(shifts, axis=1) <= max_shift_m + 1e-9]
-    shifts = shifts[np.argsort(np.linalg.norm(shifts, axis=1), kind="stable")]
-    for d in shifts[1:]:
-        p = position + d
-        if lm.value(p[None])[0] == FREE and not lm.box_has_occupied(p):
-            return p
-    return position
-
-
 def _frontier_of(res: PlanResult, iteration: int) -> Frontier | None:
     """The frontier a repositioning result leads to (its last global vertex)."""
     g = res.global_result
@@ -248,14 +126,6 @@ def parse_bbox(value: Any) -> tuple[np.ndarray, np.ndarray] | None:
     if a.shape != (3,) or b.shape != (3,) or not (np.all(np.isfinite(a)) and np.all(np.isfinite(b))):
         raise ValueError(f"exploration box corners must be three finite numbers each, got {value!r}")
     return np.minimum(a, b), np.maximum(a, b)
-
-
-def _xyz(p: np.ndarray) -> list[float]:
-    return [round(float(v), 3) for v in p]
-
-
-def _length(path: np.ndarray) -> float:
-    return float(np.linalg.norm(np.diff(path, axis=0), axis=1).sum()) if len(path) > 1 else 0.0
 
 
 # Planner parameters a tree may override: the YAML name -> GBPlannerConfig field.
@@ -409,7 +279,7 @@ class Explore(Skill):
         plan = nav.from_robot(force=True)
         if plan is None:
             return False
-        pos, reason = r.position, getattr(r, "blocked_reason", "")
+        pos, reason = r.position, r.blocked_reason
         poses = [q for q in path[::-1] if np.linalg.norm((q - pos)[:2]) > 1.0][: self.p["reroute_poses"]]
         for q in poses:
             node = nav.node_near(plan.graph, q)
@@ -418,7 +288,7 @@ class Explore(Skill):
             route = plan.path_to(node)
             self.follow(route)
             self.following, self.rerouted, self.path = True, True, route
-            self.event("explore_rerouted", to=_xyz(route[-1]), path_length_m=round(float(plan.distances[node]), 1),
+            self.event("explore_rerouted", to=xyz(route[-1]), path_length_m=round(float(plan.distances[node]), 1),
                        reason=reason)
             return True
         return False
@@ -438,7 +308,7 @@ class Explore(Skill):
         """Remember where the path was blocked (the planner's map showed a way there);
         True when too many paths in a row were blocked without progress."""
         r = self.robot
-        reason = getattr(r, "blocked_reason", "")
+        reason = r.blocked_reason
         pos = r.position
         progress = self.blocked_at is None or np.linalg.norm(pos - self.blocked_at) > 2.0 * r.mobility.radius_m
         self.blocked = 1 if progress else self.blocked + 1
@@ -450,7 +320,7 @@ class Explore(Skill):
             spot = blocked_spot(pos, self.path, ahead)
             if spot is not None:
                 gbplanner(self.ctx, r).blocked_spots.append(spot)
-        self.event("explore_path_blocked", reason=reason, no_go=None if spot is None else _xyz(spot),
+        self.event("explore_path_blocked", reason=reason, no_go=None if spot is None else xyz(spot),
                    in_a_row=self.blocked)
         self._restore_frontier()
         if self.blocked < self.p["max_blocked_paths"]:
@@ -502,10 +372,10 @@ class Explore(Skill):
             self.follow(res.path)
             self.following, self.path, self.rerouted = True, res.path, False
             self.frontier = _frontier_of(res, svc.planner.global_planner.iteration)
-            length = _length(res.path)
+            length = path_length(res.path)
             self.feedback_message = f"{res.mode}: {length:.1f} m, gain {res.gain:.0f} m3"
             self.event("gbplanner_path", mode=res.mode, gain_m3=round(res.gain, 1), path_length_m=round(length, 2),
-                       to=_xyz(res.path[-1]), frontiers=len(svc.planner.global_planner.frontiers),
+                       to=xyz(res.path[-1]), frontiers=len(svc.planner.global_planner.frontiers),
                        **({"detail": res.reason} if res.reason else {}))
             return Status.RUNNING
         if code == "exploration_complete":
@@ -550,120 +420,5 @@ class Explore(Skill):
         self.bb.set(self.k_homing, code == "homing_due")
 
 
-class Home(Skill):
-    """Go home: along GBPlanner2's global graph (the planner's homing path); when it has
-    no path, or its path turned out blocked, along the navigation graph of the onboard
-    map; and when that fails too, back along the robot's own traversed path (loops cut
-    out), which it has walked before.
-
-    Writes: ``returned_home`` (True on arrival), ``planner_mode`` (``homing``).
-    Returns: RUNNING on the way; SUCCESS within ``tolerance_m`` of home; FAILURE when
-    no path home is found, or after ``max_replans`` re-plans (blocked paths, or
-    arrivals short of home).
-    """
-
-    #: Where a path home comes from, in the order they are tried: the traversed path
-    #: with its loops cut out, then exactly as walked.
-    SOURCES = ("gbplanner2", "navigator", "traversed_path", "traversed_path_exact")
-
-    PARAMS = {
-        "tolerance_m": Param(float, 1.0, "distance to home that counts as home", exclusive_minimum=0),
-        "max_replans": Param(int, 5, "re-plans allowed after a blocked path or an arrival short of home", minimum=0),
-    }
-
-    def __init__(self, name: str, ctx: Any, remap: dict[str, str] | None = None, **params: Any):
-        super().__init__(name, ctx, remap, **params)
-        self.k_home = self.key("returned_home")
-        self.k_mode = self.key("planner_mode")
-        self.replans = 0
-        self.moving = False
-        self.first_source = 0
-        self.source = 0
-        self.walk: Any = None
-
-    def initialise(self) -> None:
-        self.replans, self.moving, self.first_source, self.source, self.walk = 0, False, 0, 0, None
-
-    def update(self) -> Status:
-        r = self.robot
-        if np.linalg.norm(r.position - r.home) <= self.p["tolerance_m"]:
-            if self.moving:
-                self.stop_own_motion()
-            self.moving = False
-            self.bb.set(self.k_home, True)
-            self.event("home_reached", endurance_s=round(r.endurance_remaining_s, 1))
-            return Status.SUCCESS
-        if self.moving:
-            status = r.path_status
-            if status == PathStatus.FOLLOWING:
-                return Status.RUNNING
-            self.moving = False
-            self.replans += 1
-            # A blocked path: the next source; an arrival short of home: from the top.
-            self.first_source = (self.source + 1) % len(self.SOURCES) if status == PathStatus.BLOCKED else 0
-            if status == PathStatus.BLOCKED:
-                self.event("homing_path_blocked", source=self.SOURCES[self.source],
-                           reason=getattr(r, "blocked_reason", ""))
-            if self.replans > self.p["max_replans"]:
-                return self._fail(f"not home after {self.replans - 1} re-plans "
-                                  f"({getattr(r, 'blocked_reason', '') or status})")
-        path = None
-        for k in range(len(self.SOURCES)):
-            self.source = (self.first_source + k) % len(self.SOURCES)
-            try:
-                path = self._path(self.SOURCES[self.source])
-            except Exception as err:  # a failed planner call never crashes the tree
-                self.event("homing_planner_error", source=self.SOURCES[self.source],
-                           reason=f"{type(err).__name__}: {err}")
-                path = None
-            if path is not None and len(path):
-                break
-        if path is None or not len(path):
-            return self._fail("no path home")
-        if not self.SOURCES[self.source].startswith("traversed_path"):
-            self.walk = None
-        path = np.vstack([path, r.home])
-        self.follow(path)
-        self.moving = True
-        self.bb.set(self.k_mode, "homing")
-        length = _length(np.vstack([r.position, path]))
-        source = self.SOURCES[self.source]
-        self.feedback_message = f"home is {length:.0f} m away ({source})"
-        self.event("homing", source=source, path_length_m=round(length, 1))
-        return Status.RUNNING
-
-    def _path(self, source: str) -> np.ndarray | None:
-        r = self.robot
-        if source == "gbplanner2":
-            res = gbplanner(self.ctx, r).planner.home(onboard_grid(self.ctx, r), r.position)
-            return res.path if res.ok else None
-        if source == "navigator":
-            path, _ = navigator(self.ctx, r).path_to_point(r.home, force=True)
-            return path
-        from .motion import TrailWalk, jump_check
-
-        trail = r.traversed_path
-        if len(trail) == 0 or np.linalg.norm(trail[0] - r.home) > self.p["tolerance_m"]:
-            return None  # a traversed path that does not start at home does not lead there
-        if source == "traversed_path":
-            self.walk = TrailWalk.plan(trail, None, can_jump=jump_check(r))
-            return self.walk.path
-        if self.walk is not None:
-            # The loop-cut way back was blocked: the rest of it exactly as walked.
-            return self.walk.exact_rest(r.position)
-        return TrailWalk.plan(trail, None, loop_radius_m=0.0).path
-
-    def _fail(self, reason: str) -> Status:
-        self.feedback_message = reason
-        self.event("homing_failed", reason=reason)
-        return Status.FAILURE
-
-    def terminate(self, new_status: Status) -> None:
-        if new_status == Status.INVALID and self.moving and self.ctx.robot is not None:
-            self.stop_own_motion()
-        self.moving = False
-
-
-__all__ = ["PLAN_REASONS", "Explore", "Home", "PlannerService", "ShrinkingLocalPlanner", "blocked_spot", "gbplanner",
-           "mark_blocked_spots", "onboard_grid", "parse_bbox", "plan_reason", "robot_config", "sealed_grid",
-           "stable_seed", "start_pose"]
+__all__ = ["PLAN_REASONS", "Explore", "PlannerService", "gbplanner", "onboard_grid", "parse_bbox", "plan_reason",
+           "robot_config", "stable_seed"]

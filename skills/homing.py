@@ -1,12 +1,16 @@
-"""Endurance and homing skills."""
+"""Endurance and homing skills: whether it is time to go home, and going home."""
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 from py_trees.common import Status
 
+from ..planners.geometry import path_length
+from ..planners.trail import TrailWalk
 from .base import Param, Skill
+from .gbplanner import gbplanner, onboard_grid
+from .motion_base import PathMotion, trail_jump_check
 from .navigation import navigator
 from .robot import PathStatus
 
@@ -57,53 +61,128 @@ class EnduranceLow(Skill):
         return Status.FAILURE
 
 
+class Home(PathMotion):
+    """Go home along the way ``path_source`` gives, re-planned when blocked or short.
 
-class ReturnHome(Skill):
-    """Walk or fly home through known free space.
+    ``path_source: gbplanner2`` (the CERBERUS homing): along GBPlanner2's global graph
+    (the planner's homing path); when it has no path, or its path turned out blocked,
+    along the navigation graph of the onboard map; and when that fails too, back
+    along the robot's own traversed path (loops cut out), which it has walked before,
+    then exactly as walked. A blocked path moves on to the next of these; an arrival
+    short of home starts again from the first.
+    ``path_source: navigator``: the shortest path on the navigation graph of the
+    onboard map, re-planned on the current map each time; straight for home where the
+    graph has none.
 
-    Writes: ``returned_home`` (True on arrival). Returns RUNNING on the way; SUCCESS
-    within ``tolerance_m`` of home; FAILURE when no path home is found after
-    ``max_replans`` attempts.
+    Writes: ``returned_home`` (True on arrival), ``planner_mode`` (``homing``).
+    Returns: RUNNING on the way; SUCCESS within ``tolerance_m`` of home; FAILURE when
+    no path home is found, or after ``max_replans`` re-plans (blocked paths, or
+    arrivals short of home).
     """
 
-    PARAMS = {
-        "tolerance_m": Param(float, 1.0, "distance to home that counts as home", exclusive_minimum=0),
-        "max_replans": Param(int, 5, "re-plans allowed after a blocked path", minimum=0),
+    #: Where the way home comes from, by ``path_source``: the sources in the order they
+    #: are tried, and whether the robot heads straight for home when none has a path
+    #: (else FAILURE). ``traversed_path`` has its loops cut out, ``traversed_path_exact``
+    #: is exactly as walked.
+    PATH_SOURCES: ClassVar[dict[str, tuple[tuple[str, ...], bool]]] = {
+        "gbplanner2": (("gbplanner2", "navigator", "traversed_path", "traversed_path_exact"), False),
+        "navigator": (("navigator",), True),
     }
+
+    PARAMS = {
+        "path_source": Param(str, "gbplanner2", "where the way home comes from: GBPlanner2's global graph (with "
+                             "the navigation graph and the traversed path as fall-backs), or the navigation graph "
+                             "of the onboard map", choices=tuple(PATH_SOURCES)),
+        "tolerance_m": Param(float, 1.0, "distance to home that counts as home", exclusive_minimum=0),
+        "max_replans": Param(int, 5, "re-plans allowed after a blocked path or an arrival short of home", minimum=0),
+    }
+
+    #: Former YAML names of this behaviour, and the parameters each stands for.
+    ALIASES: ClassVar[dict[str, dict[str, Any]]] = {"ReturnHome": {"path_source": "navigator"}}
 
     def __init__(self, name: str, ctx: Any, remap: dict[str, str] | None = None, **params: Any):
         super().__init__(name, ctx, remap, **params)
         self.k_home = self.key("returned_home")
-        self.replans = 0
-        self.moving = False
+        self.k_mode = self.key("planner_mode")
+        self.sources, self.straight_home = self.PATH_SOURCES[self.p["path_source"]]
+        self.first_source = 0
+        self.source = 0
+        self.walk: TrailWalk | None = None
 
     def initialise(self) -> None:
-        self.replans, self.moving = 0, False
+        super().initialise()
+        self.first_source, self.source, self.walk = 0, 0, None
 
-    def update(self) -> Status:
+    def reached(self) -> bool:
         r = self.robot
-        if np.linalg.norm(r.position - r.home) <= self.p["tolerance_m"]:
-            r.stop()
-            self.bb.set(self.k_home, True)
-            self.event("home_reached", endurance_s=round(r.endurance_remaining_s, 1))
-            return Status.SUCCESS
-        if self.moving and r.path_status == PathStatus.FOLLOWING:
-            return Status.RUNNING
-        if self.moving:
-            self.replans += 1
-            if self.replans > self.p["max_replans"]:
-                self.feedback_message = "no way home"
-                self.event("homing_failed", reason=getattr(r, "blocked_reason", ""))
-                return Status.FAILURE
-        path, length = navigator(self.ctx, r).path_to_point(r.home, force=True)
-        if path is None:
-            path = np.array([r.home])  # the last stretch: straight to the start pose
-        self.follow(np.vstack([path, r.home]))
-        self.moving = True
-        self.feedback_message = f"home is {length:.0f} m away"
-        self.event("homing", path_length_m=round(length, 1) if np.isfinite(length) else None)
+        return bool(np.linalg.norm(r.position - r.home) <= self.p["tolerance_m"])
+
+    def arrived(self) -> Status:
+        self.bb.set(self.k_home, True)
+        self.event("home_reached", endurance_s=round(self.robot.endurance_remaining_s, 1))
+        return Status.SUCCESS
+
+    def path_ended(self, status: PathStatus) -> Status | None:
+        # A blocked path: the next source; an arrival short of home: from the top.
+        self.first_source = (self.source + 1) % len(self.sources) if status == PathStatus.BLOCKED else 0
+        if status == PathStatus.BLOCKED:
+            self.event("homing_path_blocked", source=self.sources[self.source], reason=self.robot.blocked_reason)
+        return None
+
+    def give_up(self, status: PathStatus, reason: str) -> Status:
+        return self._fail(f"not home after {self.replans - 1} re-plans ({reason or status})")
+
+    def plan(self) -> Status:
+        r = self.robot
+        path = None
+        for k in range(len(self.sources)):
+            self.source = (self.first_source + k) % len(self.sources)
+            try:
+                path = self._path(self.sources[self.source])
+            except Exception as err:  # a failed planner call never crashes the tree
+                self.event("homing_planner_error", source=self.sources[self.source],
+                           reason=f"{type(err).__name__}: {err}")
+                path = None
+            if path is not None and len(path):
+                break
+        source = self.sources[self.source]
+        if path is None or not len(path):
+            if not self.straight_home:
+                return self._fail("no path home")
+            path, source = np.array([r.home]), "straight"  # the last stretch: straight to the start pose
+        if not source.startswith("traversed_path"):
+            self.walk = None
+        path = np.vstack([path, r.home])
+        self.drive(path)
+        self.bb.set(self.k_mode, "homing")
+        length = path_length(np.vstack([r.position, path]))
+        self.feedback_message = f"home is {length:.0f} m away ({source})"
+        self.event("homing", source=source, path_length_m=round(length, 1))
         return Status.RUNNING
 
-    def terminate(self, new_status: Status) -> None:
-        if new_status == Status.INVALID and self.ctx.robot is not None:
-            self.stop_own_motion()
+    def _path(self, source: str) -> np.ndarray | None:
+        r = self.robot
+        if source == "gbplanner2":
+            res = gbplanner(self.ctx, r).planner.home(onboard_grid(self.ctx, r), r.position)
+            return res.path if res.ok else None
+        if source == "navigator":
+            path, _ = navigator(self.ctx, r).path_to_point(r.home, force=True)
+            return path
+        trail = r.traversed_path
+        if len(trail) == 0 or np.linalg.norm(trail[0] - r.home) > self.p["tolerance_m"]:
+            return None  # a traversed path that does not start at home does not lead there
+        if source == "traversed_path":
+            self.walk = TrailWalk.plan(trail, None, can_jump=trail_jump_check(r))
+            return self.walk.path
+        if self.walk is not None:
+            # The loop-cut way back was blocked: the rest of it exactly as walked.
+            return self.walk.exact_rest(r.position)
+        return TrailWalk.plan(trail, None, loop_radius_m=0.0).path
+
+    def _fail(self, reason: str) -> Status:
+        self.feedback_message = reason
+        self.event("homing_failed", reason=reason)
+        return Status.FAILURE
+
+
+__all__ = ["EnduranceLow", "Home"]

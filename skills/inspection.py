@@ -12,9 +12,7 @@ workspace, a full scan: pause the running motion, stop, scan every point, resume
 same path. Otherwise the points are scanned while the robot walks on.
 
 Visibility is worked out on the robot's onboard map, as the paper's ray casting in the
-planner's volumetric map: a surface voxel is seen from an eye when it lies within
-range and inside the camera's view, and the straight line to it crosses no occupied
-voxel other than the voxel itself and its 26 neighbours.
+planner's volumetric map (``delve.planners.visibility``).
 """
 from __future__ import annotations
 
@@ -25,8 +23,9 @@ from typing import Any, ClassVar
 import numpy as np
 from py_trees.common import Status
 
-from ..planners.occupancy import OCCUPIED
+from ..planners.geometry import path_length, xyz
 from ..planners.scan_points import ScanPointSelection, select_scan_points
+from ..planners.visibility import BodyCameras, first_hit_m, joint_directions, line_of_sight, surface_voxels
 from .base import AgentContext, Param, Skill
 from .navigation import navigator
 from .robot import MapView, PathStatus, Payload, Robot
@@ -35,89 +34,8 @@ from .robot import MapView, PathStatus, Payload, Robot
 SEEN_SERVICE = "body_camera_seen"
 #: Mode of a requested point whose area is all seen: it is looked at once.
 OPERATOR_POINT_SCAN = "operator_point_scan"
-#: Line-of-sight samples per voxel along a ray.
-_SAMPLES_PER_VOXEL = 2
-#: Rays are marched in chunks of this many, to bound memory.
-_CHUNK = 2048
 #: Surface points per block of the visibility matrix, to bound memory.
 _ROWS = 512
-
-
-# ---- geometry on the onboard map ----------------------------------------------------
-def surface_voxels(onboard_map: MapView, centre: np.ndarray,
-                   radius_m: float) -> tuple[np.ndarray, np.ndarray]:
-    """Occupied voxels of the map whose centres lie within ``radius_m`` of ``centre``:
-    their indices (N, 3) and centre positions (N, 3)."""
-    occ = onboard_map.occupancy
-    origin, vox = np.asarray(onboard_map.origin, float), float(onboard_map.voxel_size_m)
-    centre = np.asarray(centre, float)
-    lo = np.maximum(np.floor((centre - radius_m - origin) / vox).astype(int), 0)
-    hi = np.minimum(np.floor((centre + radius_m - origin) / vox).astype(int) + 1, np.array(occ.shape))
-    if np.any(hi <= lo):
-        return np.zeros((0, 3), dtype=np.int64), np.zeros((0, 3))
-    box = occ[lo[0]:hi[0], lo[1]:hi[1], lo[2]:hi[2]]
-    ijk = np.argwhere(box == OCCUPIED).astype(np.int64) + lo
-    pts = origin + (ijk + 0.5) * vox
-    near = np.linalg.norm(pts - centre, axis=1) <= radius_m
-    return ijk[near], pts[near]
-
-
-def line_of_sight(onboard_map: MapView, eye: np.ndarray, target_ijk: np.ndarray) -> np.ndarray:
-    """(N,) bool: whether the straight line from ``eye`` to each target voxel's centre
-    crosses no occupied voxel other than the target and its 26 neighbours (so that
-    surface voxels seen at a slant along their own wall still count)."""
-    occ = onboard_map.occupancy
-    flat_occ = occ.reshape(-1)
-    origin, vox = np.asarray(onboard_map.origin, float), float(onboard_map.voxel_size_m)
-    target_ijk = np.asarray(target_ijk, dtype=np.int64).reshape(-1, 3)
-    out = np.ones(len(target_ijk), dtype=bool)
-    shape = np.array(occ.shape, dtype=np.int32)
-    start_v = ((np.asarray(eye, float) - origin) / vox).astype(np.float32)      # in voxel units
-    step = np.float32(1.0 / _SAMPLES_PER_VOXEL)
-    for first in range(0, len(target_ijk), _CHUNK):
-        ijk = target_ijk[first:first + _CHUNK].astype(np.int32)
-        rel = ijk.astype(np.float32) + np.float32(0.5) - start_v
-        dist = np.linalg.norm(rel, axis=1)
-        if not len(dist) or dist.max() <= 0:
-            continue
-        t = (np.arange(math.ceil(float(dist.max()) / step), dtype=np.float32) + np.float32(0.5)) * step
-        direction = rel / np.maximum(dist, np.float32(1e-6))[:, None]
-        idx = np.floor(start_v + direction[:, None, :] * t[None, :, None]).astype(np.int32)
-        check = t[None, :] < dist[:, None]
-        check &= (np.abs(idx - ijk[:, None, :]) > 1).any(axis=2)
-        check &= ((idx >= 0) & (idx < shape)).all(axis=2)
-        i = idx[check]
-        flat = (i[:, 0].astype(np.int64) * shape[1] + i[:, 1]) * shape[2] + i[:, 2]
-        blocked = np.zeros(check.shape, dtype=bool)
-        blocked[check] = flat_occ[flat] == OCCUPIED
-        out[first:first + len(ijk)] = ~blocked.any(axis=1)
-    return out
-
-
-def first_hit_m(onboard_map: MapView, eye: np.ndarray, directions: np.ndarray,
-                max_range_m: float) -> np.ndarray:
-    """(K,) distance along each unit direction from ``eye`` to the first occupied voxel
-    of the map; ``max_range_m`` when there is none within it."""
-    occ = onboard_map.occupancy
-    origin, vox = np.asarray(onboard_map.origin, float), float(onboard_map.voxel_size_m)
-    step = vox / _SAMPLES_PER_VOXEL
-    t = (np.arange(math.ceil(max_range_m / step)) + 0.5) * step
-    samples = np.asarray(eye, float) + directions[:, None, :] * t[None, :, None]
-    idx = np.floor((samples - origin) / vox).astype(np.int64)
-    inside = np.all((idx >= 0) & (idx < np.array(occ.shape)), axis=2)
-    hit = np.zeros(inside.shape, dtype=bool)
-    i = idx[inside]
-    hit[inside] = occ[i[:, 0], i[:, 1], i[:, 2]] == OCCUPIED
-    first = np.where(hit.any(axis=1), t[np.argmax(hit, axis=1)], max_range_m)
-    return np.minimum(first, max_range_m)
-
-
-def joint_directions(candidates: np.ndarray, body_yaw_rad: float) -> np.ndarray:
-    """(K, 3) world unit vectors of the camera's optical axis at each (yaw, pitch) in
-    degrees, for a body turned ``body_yaw_rad`` about the vertical."""
-    yaw = np.radians(candidates[:, 0]) + body_yaw_rad
-    pitch = np.radians(candidates[:, 1])
-    return np.stack([np.cos(pitch) * np.cos(yaw), np.cos(pitch) * np.sin(yaw), np.sin(pitch)], axis=1)
 
 
 def joints_toward(payload: Payload, body_pose: np.ndarray, target: np.ndarray) -> tuple[float, float]:
@@ -131,34 +49,6 @@ def joints_toward(payload: Payload, body_pose: np.ndarray, target: np.ndarray) -
     pitch = math.degrees(math.atan2(rel[2], math.hypot(x, y)))
     (ylo, yhi), (plo, phi) = payload.spec.yaw_limits_deg, payload.spec.pitch_limits_deg
     return float(np.clip(yaw, ylo, yhi)), float(np.clip(pitch, plo, phi))
-
-
-@dataclass(frozen=True)
-class BodyCameras:
-    """The fixed wide cameras on the body (the ANYmal's Alphasense Core): a ring
-    ``horizontal_fov_deg`` wide around the heading (360: all round) and
-    ``vertical_fov_deg`` high about ``pitch_deg`` of elevation, ``height_m`` above the
-    body centre, that sees surface within ``range_m``."""
-
-    range_m: float = 5.0
-    horizontal_fov_deg: float = 360.0
-    vertical_fov_deg: float = 60.0
-    pitch_deg: float = 0.0
-    height_m: float = 0.1
-
-    def eye(self, position: np.ndarray) -> np.ndarray:
-        return np.asarray(position, float) + np.array([0.0, 0.0, self.height_m])
-
-    def in_view(self, points: np.ndarray, eye: np.ndarray, yaw_rad: float) -> np.ndarray:
-        """(N,) bool: inside range and the cameras' view (ignoring occlusion)."""
-        rel = np.asarray(points, float).reshape(-1, 3) - eye
-        dist = np.linalg.norm(rel, axis=1)
-        elevation = np.degrees(np.arctan2(rel[:, 2], np.hypot(rel[:, 0], rel[:, 1])))
-        ok = (dist <= self.range_m) & (np.abs(elevation - self.pitch_deg) <= self.vertical_fov_deg / 2)
-        if self.horizontal_fov_deg < 360.0:
-            bearing = np.degrees(np.arctan2(rel[:, 1], rel[:, 0]) - yaw_rad)
-            ok &= np.abs((bearing + 180.0) % 360.0 - 180.0) <= self.horizontal_fov_deg / 2
-        return ok
 
 
 @dataclass
@@ -180,12 +70,7 @@ class SeenRecord:
     def look(self, robot: Robot, cameras: BodyCameras) -> int:
         """Mark what the body cameras see from the robot's pose now; returns how many
         surface voxels they see for the first time."""
-        eye = cameras.eye(robot.position)
-        m = robot.onboard_map
-        ijk, pts = surface_voxels(m, eye, cameras.range_m)
-        ijk = ijk[cameras.in_view(pts, eye, robot.yaw_rad)]
-        ijk = ijk[~self.of(ijk)]                     # only what is not seen yet needs a ray
-        ijk = ijk[line_of_sight(m, eye, ijk)]
+        ijk = cameras.visible(robot.onboard_map, robot.position, robot.yaw_rad, skip=self.seen)
         self.mark(ijk)
         self.updates += 1
         return len(ijk)
@@ -346,12 +231,8 @@ def plan_inspection(robot: Robot, record: SeenRecord, *, point: np.ndarray | Non
     return InspectionPlan(sel, scans, mode, int(reachable.sum()), ijk[unseen], unseen_pts)
 
 
-def _xyz(p: np.ndarray) -> list[float]:
-    return [round(float(v), 3) for v in p]
-
-
 def _path(path: np.ndarray) -> list[list[float]]:
-    return [_xyz(p) for p in np.asarray(path).reshape(-1, 3)]
+    return [xyz(p) for p in np.asarray(path).reshape(-1, 3)]
 
 
 class Inspect(Skill):
@@ -488,7 +369,7 @@ class Inspect(Skill):
         r = self.robot
         point = job.request.get("point")
         self.event("inspection_start", trigger=True, point=point, requested_s=job.request.get("requested_s"),
-                   position=_xyz(r.position))
+                   position=xyz(r.position))
         if r.payload is None:
             return self._fail("no_payload", f"{r.name} carries no inspection payload")
         if point is not None:
@@ -513,7 +394,7 @@ class Inspect(Skill):
             self._pause(job, "walk to the point")
             job.phase, job.approached = "approach", True
             self.follow(path)
-            self.event("inspection_approach", point=_xyz(job.point), path_length_m=round(_length(path), 2))
+            self.event("inspection_approach", point=xyz(job.point), path_length_m=round(path_length(path), 2))
             self.feedback_message = "walking toward the point"
             return Status.RUNNING
         return self._select(job)
@@ -552,7 +433,7 @@ class Inspect(Skill):
                     "unseen_fraction": round(sel.unseen_fraction, 4), "solver": sel.solver,
                     "optimal": sel.optimal, "planned_covered_fraction": round(sel.covered_fraction, 4)}
         self.event("inspection_scan_points", mode=job.mode, full_scan=job.full_scan,
-                   scan_points=len(job.scans), position=_xyz(r.position), **job.info)
+                   scan_points=len(job.scans), position=xyz(r.position), **job.info)
         if job.full_scan:
             if not job.approached:
                 self._pause(job, "full scan")
@@ -598,13 +479,13 @@ class Inspect(Skill):
         return self._done(job)
 
     def _pause(self, job: _Job, why: str) -> None:
-        self.event("inspection_pause", reason=why, position=_xyz(self.robot.position),
+        self.event("inspection_pause", reason=why, position=xyz(self.robot.position),
                    path=_path(job.paused_path))
 
     def _log_resume(self, job: _Job) -> None:
         way = len(job.resume_path) - len(job.paused_path)
         self.event("inspection_resume", path=_path(job.resume_path), way_back_waypoints=way,
-                   position=_xyz(self.robot.position))
+                   position=xyz(self.robot.position))
 
     # ---- scanning -------------------------------------------------------------------
     def _aim(self, job: _Job, start_s: float) -> None:
@@ -657,7 +538,7 @@ class Inspect(Skill):
         job.captured += 1
         self.event("inspection_scan", index=job.current, yaw_deg=round(payload.yaw_deg, 2),
                    pitch_deg=round(payload.pitch_deg, 2), zoom=payload.zoom, newly_covered=int(new.sum()),
-                   position=_xyz(r.position), moving=r.path_status == PathStatus.FOLLOWING)
+                   position=xyz(r.position), moving=r.path_status == PathStatus.FOLLOWING)
 
     def _keep_walking(self, job: _Job) -> None:
         """Keep the robot walking on the interrupted path while the payload scans."""
@@ -737,7 +618,7 @@ class Inspect(Skill):
         covered = job.info.get("covered_fraction", 1.0)
         result = {
             "ok": True,
-            "point": None if job.point is None else _xyz(job.point),
+            "point": None if job.point is None else xyz(job.point),
             "requested_s": job.request.get("requested_s"),
             "done_s": round(self.ctx.clock.now_s, 3),
             "mode": job.mode,
@@ -778,7 +659,3 @@ class Inspect(Skill):
         if self.get(self.k_request) == job.request:
             self.bb.set(self.k_request, None)
 
-
-def _length(path: np.ndarray) -> float:
-    p = np.asarray(path, float).reshape(-1, 3)
-    return float(np.linalg.norm(np.diff(p, axis=0), axis=1).sum()) if len(p) > 1 else 0.0

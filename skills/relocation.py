@@ -6,13 +6,15 @@ from typing import Any
 
 from py_trees.common import Access, Status
 
+from ..planners.geometry import xyz
 from .base import Param, Skill
 from .gbplanner import gbplanner
+from .motion_base import PathMotion
 from .navigation import navigator
 from .robot import PathStatus
 
 
-class Relocate(Skill):
+class Relocate(PathMotion):
     """Relocate to the best frontier of GBPlanner2's global graph (gain over path
     length, among frontiers from which the robot can still get home).
 
@@ -26,38 +28,28 @@ class Relocate(Skill):
     def __init__(self, name: str, ctx: Any, remap: dict[str, str] | None = None, **params: Any):
         super().__init__(name, ctx, remap, **params)
         self.k_target = self.key("relocation_target")
-        self.moving, self.replans = False, 0
 
-    def initialise(self) -> None:
-        self.moving, self.replans = False, 0
+    def path_ended(self, status: PathStatus) -> Status | None:
+        if status == PathStatus.ARRIVED:
+            self.event("relocated", at=xyz(self.robot.position, 2))
+            return Status.SUCCESS
+        return None
 
-    def update(self) -> Status:
+    def give_up(self, status: PathStatus, reason: str) -> Status:
+        return self._fail(f"path blocked {self.replans} times")
+
+    def plan(self) -> Status:
         r = self.robot
-        if self.moving:
-            if r.path_status == PathStatus.FOLLOWING:
-                return Status.RUNNING
-            if r.path_status == PathStatus.ARRIVED:
-                self.event("relocated", at=[round(float(v), 2) for v in r.position])
-                return Status.SUCCESS
-            self.replans += 1
-            if self.replans > self.p["max_replans"]:
-                return self._fail(f"path blocked {self.replans} times")
         planner = gbplanner(self.ctx, r).planner
         res = planner.global_planner.plan_reposition(navigator(self.ctx, r).grid(), r.position,
                                                      r.endurance_remaining_s)
         if res.path is None:
             return self._fail(res.reason or "no frontier to relocate to")
-        self.follow(res.path)
-        self.moving = True
-        target = [round(float(v), 2) for v in res.target] if res.target is not None else None
+        self.drive(res.path)
+        target = xyz(res.target, 2) if res.target is not None else None
         self.bb.set(self.k_target, target)
         self.event("relocate", trigger=True, to=target, path_length_m=round(res.length_m, 1))
         return Status.RUNNING
-
-    def terminate(self, new_status: Status) -> None:
-        if new_status == Status.INVALID:
-            self.stop_own_motion()
-        self.moving = False
 
     def _fail(self, reason: str) -> Status:
         self.feedback_message = reason
@@ -87,7 +79,7 @@ class DeployBreadcrumb(Skill):
             self.event("breadcrumb_failed", reason=drop.error)
             return Status.FAILURE
         self.event("breadcrumb_dropped", trigger=True, name=drop.name, remaining=drop.remaining,
-                   at=[round(float(v), 2) for v in self.robot.position])
+                   at=xyz(self.robot.position, 2))
         return Status.SUCCESS
 
 

@@ -236,6 +236,11 @@ class Robot(Protocol):
     def path_status(self) -> PathStatus: ...
 
     @property
+    def blocked_reason(self) -> str:
+        """Why the last path is BLOCKED (rock in the way, a step too high, ...); "" while
+        it is not."""
+
+    @property
     def breadcrumbs(self) -> int:
         """Breadcrumbs (mesh relay nodes) the robot still carries."""
 

@@ -8,6 +8,7 @@ from typing import Any
 import numpy as np
 from py_trees.common import Access, Status
 
+from ..planners.geometry import xyz
 from .base import Param, Skill
 from .robot import PathStatus
 
@@ -47,7 +48,7 @@ class RobotStuck(Skill):
         if now - t0 >= self.p["stuck_time_s"] and spread < self.p["min_motion_m"]:
             self.history.clear()
             self.feedback_message = f"no motion for {self.p['stuck_time_s']:.0f} s"
-            self.event("watchdog", trigger=True, position=[round(float(v), 2) for v in r.position])
+            self.event("watchdog", trigger=True, position=xyz(r.position, 2))
             return Status.SUCCESS
         return Status.FAILURE
 

@@ -38,3 +38,24 @@ def test_registry_rejects_duplicates():
 def test_default_registry_is_cached():
     assert default_registry() is default_registry()
 
+
+
+def test_a_former_skill_name_builds_the_new_form_and_says_so_once(tmp_path, capsys):
+    from delve.executive.errors import DelveError
+    from delve.executive.tree_loader import check_context, load_tree
+    from delve.skills.homing import Home
+
+    alias = default_registry()["ReturnHome"]
+    assert alias.kind == "skill" and "path_source" not in alias.params and "Deprecated" in alias.doc
+    tree = tmp_path / "old.yaml"
+    tree.write_text("type: Sequence\nchildren:\n  - type: ReturnHome\n    max_replans: 2\n")
+    for _ in range(2):
+        root = load_tree(tree, check_context())
+        (node,) = root.children
+        assert type(node) is Home and node.p["path_source"] == "navigator" and node.p["max_replans"] == 2
+    err = capsys.readouterr().err
+    assert err.count("deprecated") == 1
+    assert "old.yaml:3: type 'ReturnHome' is deprecated: write type: Home, path_source: navigator" in err
+    tree.write_text("type: ReturnHome\npath_source: gbplanner2\n")
+    with pytest.raises(DelveError, match="path_source"):
+        load_tree(tree, check_context())

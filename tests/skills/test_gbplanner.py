@@ -1,4 +1,5 @@
-"""delve.skills.gbplanner: Explore and Home on a small fake robot over synthetic maps."""
+"""delve.skills.gbplanner: Explore, and Home along GBPlanner2's global graph, on a small fake
+robot over synthetic maps."""
 from __future__ import annotations
 
 import zlib
@@ -9,20 +10,9 @@ import pytest
 from delve.executive.errors import DelveError
 from delve.executive.tree_loader import build_tree, check_context
 from delve.planners.gbplanner2 import synthetic as syn
-from delve.planners.occupancy import FREE, OCCUPIED, UNKNOWN, Grid
-from delve.skills.gbplanner import (
-    SERVICE,
-    Explore,
-    Home,
-    ShrinkingLocalPlanner,
-    blocked_spot,
-    gbplanner,
-    mark_blocked_spots,
-    parse_bbox,
-    robot_config,
-    sealed_grid,
-    stable_seed,
-)
+from delve.planners.gbplanner2.local_planner import ShrinkingLocalPlanner
+from delve.skills.gbplanner import SERVICE, Explore, gbplanner, parse_bbox, robot_config, stable_seed
+from delve.skills.homing import Home
 from py_trees.common import Status
 
 from .fakes import FakeRobot, events, make_ctx, run
@@ -117,18 +107,6 @@ def test_parse_bbox():
         parse_bbox({"min": [0, 0]})
     with pytest.raises(ValueError):
         parse_bbox([[0, 0, 0]])
-
-
-def test_sealed_grid_closes_one_voxel_gaps_in_the_rock_surface():
-    occ = np.full((5, 5, 5), UNKNOWN, np.int8)
-    occ[1:4, 1:4, 1:4] = FREE
-    occ[0, :, :] = OCCUPIED
-    grid = Grid(occ, np.zeros(3), 0.2)
-    out = sealed_grid(grid)
-    assert out.occupancy[1, 0, 0] == OCCUPIED  # unknown, touches rock
-    assert out.occupancy[4, 4, 4] == UNKNOWN   # unknown, no rock beside it
-    assert np.array_equal(out.occupancy == FREE, occ == FREE)
-    assert grid.occupancy[1, 0, 0] == UNKNOWN  # the map itself is untouched
 
 
 # --------------------------------------------------------------------------- Explore
@@ -285,23 +263,6 @@ def test_a_blocked_path_is_rerouted_on_the_navigation_graph_once(half_mapped):
     assert len(events(ctx, "explore_path_blocked")) == 1 and len(events(ctx, "explore_rerouted")) == 1
 
 
-def test_blocked_spot_and_its_rock():
-    path = np.array([[0.0, 0.0, 1.5], [2.0, 0.0, 1.5], [2.0, 2.0, 1.5]])
-    assert np.allclose(blocked_spot(np.array([1.0, 0.0, 1.5]), path, 0.7), [1.7, 0.0, 1.5])
-    # At a corner: towards the next waypoint, not the one reached.
-    assert np.allclose(blocked_spot(np.array([2.0, 0.0, 1.5]), path, 0.7), [2.0, 0.7, 1.5])
-    assert blocked_spot(np.zeros(3), None, 0.7) is None
-    occ = np.zeros((20, 20, 15), np.int8)
-    grid = Grid(occ, np.zeros(3), 0.2)
-    out = mark_blocked_spots(grid, [np.array([2.0, 2.0, 1.5])], 0.3, 0.7)
-    rock = np.argwhere(out.occupancy == OCCUPIED)
-    assert len(rock) and grid.occupancy.max() == 0
-    centres = grid.to_world(rock)
-    assert np.all(np.hypot(centres[:, 0] - 2.0, centres[:, 1] - 2.0) <= 0.3 + 0.2)
-    assert centres[:, 2].min() >= 0.7 and centres[:, 2].max() <= 1.9 + 1e-9
-    assert mark_blocked_spots(grid, [], 0.3, 0.7) is grid
-
-
 def test_explore_stays_inside_the_exploration_box(half_mapped):
     grid, a, _ = half_mapped
     robot = FakeRobot(grid, body(a, 12.0))
@@ -315,24 +276,6 @@ def test_explore_stays_inside_the_exploration_box(half_mapped):
     assert robot.paths
     for path in robot.paths:
         assert path[:, 0].max() <= a[0] + 15.0 + 0.6  # vertices in the box; improvement moves them <= 0.5 m
-
-
-def test_shrinking_local_planner_refills_a_graph_starved_box(monkeypatch):
-    """A 2 m wide tunnel in a wide, mostly rock and unknown local box: graph building
-    stops after its first batch of samples, and the smaller box fills with vertices."""
-    import delve.planners.gbplanner2.local_planner as lp
-    from delve.planners.gbplanner2 import LocalBound
-
-    grid, a, _ = syn.straight_tunnel(length_m=40, width_m=2.0)
-    p = body(a, 10.0)
-    cfg = robot_config(FakeRobot(grid, p)).replace(num_vertices_max=150, num_edges_max=2500)
-    huge = LocalBound(p, np.eye(3), np.array([17.5, 17.5, 8.0]))
-    monkeypatch.setattr(lp, "adaptive_local_bound", lambda *args, **kwargs: huge)
-    starved = lp.LocalPlanner(cfg).plan(grid, p, np.random.default_rng(0))
-    assert starved.graph.num_vertices < ShrinkingLocalPlanner.min_vertices
-    res = ShrinkingLocalPlanner(cfg).plan(grid, p, np.random.default_rng(0))
-    assert res.graph.num_vertices >= ShrinkingLocalPlanner.min_vertices
-    assert np.all(res.graph.bound.half_extents_m < huge.half_extents_m)
 
 
 # ------------------------------------------------------------------------------ Home

@@ -9,26 +9,23 @@ import py_trees
 import pytest
 from delve.executive.tree_loader import load_tree
 from delve.planners.gbplanner2 import synthetic as syn
-from delve.planners.occupancy import OCCUPIED, Grid
+from delve.planners.occupancy import Grid
 from delve.sim.payload import PanTiltZoomCamera
 from delve.skills.base import Skill
+from delve.planners.visibility import BodyCameras, joint_directions
 from delve.skills.inspection import (
     SEEN_SERVICE,
-    BodyCameras,
     Inspect,
     SeenRecord,
     body_pose,
-    joint_directions,
     joints_toward,
-    line_of_sight,
     plan_inspection,
-    surface_voxels,
 )
 from delve.skills.robot import PathStatus
 from py_trees.common import Status
 
 from . import fakes
-from .fakes import FakeMap, make_ctx
+from .fakes import make_ctx
 
 TREES = Path(__file__).resolve().parents[2] / "trees"
 #: Body cameras that see only a thin band about the horizon: most of the payload's
@@ -112,29 +109,6 @@ def straight_path(start, length_m: float, spacing_m: float = 2.0) -> np.ndarray:
 
 
 # ------------------------------------------------------------------------- geometry
-def test_surface_voxels_are_the_occupied_voxels_within_range(tunnel):
-    grid, start, _ = tunnel
-    robot = camera_robot(grid, body(start, 8))
-    ijk, pts = surface_voxels(robot.onboard_map, robot.position, 5.0)
-    assert len(pts) > 100
-    assert np.all(np.linalg.norm(pts - robot.position, axis=1) <= 5.0)
-    assert np.all(grid.occupancy[ijk[:, 0], ijk[:, 1], ijk[:, 2]] == OCCUPIED)
-
-
-def test_line_of_sight_is_blocked_by_rock_on_the_onboard_map():
-    grid = syn.carve((12, 6, 5), 0.2, [syn.Tunnel((1, 3, 1), (11, 3, 1), 4.0, 3.0)])
-    occ = grid.occupancy.copy()
-    pillar = grid.to_index(np.array([[6.0, 3.0, 2.0]]))[0]
-    occ[pillar[0] - 1:pillar[0] + 2, pillar[1] - 1:pillar[1] + 2, :] = OCCUPIED     # a pillar, floor to roof
-    m = FakeMap(Grid(occ, grid.origin, grid.voxel_size_m))
-    eye = np.array([3.0, 3.0, 2.0])
-    far_wall = grid.to_index(np.array([[9.0, 3.0, 4.1]]))         # the roof, behind the pillar
-    near_wall = grid.to_index(np.array([[4.0, 3.0, 4.1]]))        # the roof, before it
-    assert occ[tuple(far_wall[0])] == OCCUPIED and occ[tuple(near_wall[0])] == OCCUPIED
-    assert not line_of_sight(m, eye, far_wall)[0]
-    assert line_of_sight(m, eye, near_wall)[0]
-
-
 def test_joints_toward_a_point_on_a_candidates_axis_give_that_candidate():
     cam = PanTiltZoomCamera(None, occlusion_tolerance_m=0.2)
     pose = np.array([1.0, 2.0, 0.5, 0.7])
@@ -145,15 +119,6 @@ def test_joints_toward_a_point_on_a_candidates_axis_give_that_candidate():
         assert np.allclose(joints_toward(cam, pose, target), c, atol=1e-6)
         # the axis is what the payload's own view model calls straight ahead
         assert cam.in_view(target[None], pose, c[None])[0, 0]
-
-
-def test_body_cameras_see_a_band_about_the_horizon():
-    cams = BodyCameras(range_m=5.0, vertical_fov_deg=60.0)
-    eye = np.zeros(3)
-    pts = np.array([[3.0, 0, 0], [-3.0, 0, 1.0], [1.0, 0, 2.0], [6.0, 0, 0], [0, 3.0, -1.0]])
-    assert cams.in_view(pts, eye, 0.0).tolist() == [True, True, False, False, True]
-    front = BodyCameras(horizontal_fov_deg=180.0)
-    assert front.in_view(pts, eye, 0.0).tolist() == [True, False, False, False, True]
 
 
 def test_walking_counts_what_the_body_cameras_saw_earlier(tunnel):
