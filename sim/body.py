@@ -41,6 +41,13 @@ class RobotBody:
         return self._pos.copy()
 
     @property
+    def view_up_deg(self) -> float:
+        """How far above the horizontal the platform's LiDAR sees (half its vertical view
+        above its pitch)."""
+        lidar = self._platform.lidar
+        return lidar.pitch_deg + lidar.vertical_fov_deg / 2
+
+    @property
     def home(self) -> np.ndarray:
         return self._home.copy()
 

@@ -1,6 +1,7 @@
 """A robot on a graph world: it drives tunnel by tunnel and explores the locations
 it reaches. It implements the robot interface's motion and radio parts and its
-``NetworkView`` (``topology``, ``location``, ``route``); there is no voxel map."""
+``NetworkView`` (``topology``, ``location``, ``route``); there is no voxel map (its
+onboard map is empty), no payload and no breadcrumb."""
 from __future__ import annotations
 
 from typing import Any
@@ -12,6 +13,8 @@ from .body import RobotBody
 from .graph_radio import GraphRadioEndpoint
 from .graph_world import GraphWorld, Known
 from .platforms import Platform
+from .radio import BreadcrumbDrop
+from .voxel_map import VoxelMap
 
 IDLE, FOLLOWING, ARRIVED, BLOCKED = "idle", "following", "arrived", "blocked"
 
@@ -45,6 +48,7 @@ class GraphRobot(RobotBody):
         self._stuck_s = 0.0
         self.transitions = 0
         self._known = Known()
+        self._map = VoxelMap((0, 0, 0), self._home, 1.0)
         self._arrive()
 
     # ---- the robot interface (motion, radio; the rest in RobotBody) ---------------
@@ -105,6 +109,31 @@ class GraphRobot(RobotBody):
         self._status = BLOCKED
         self.blocked_reason = "robot lost"
         self._radio.silent = True
+
+    # ---- the rest of the robot interface: what a graph robot does without -----------
+    @property
+    def yaw_rad(self) -> float:
+        """A graph robot keeps no heading: 0."""
+        return 0.0
+
+    @property
+    def onboard_map(self) -> VoxelMap:
+        """Empty: a graph robot senses locations, not voxels (its map is ``topology``)."""
+        return self._map
+
+    def reset_local_map(self, radius_m: float) -> None:
+        """Nothing to forget: the onboard map is empty."""
+
+    @property
+    def breadcrumbs(self) -> int:
+        return 0
+
+    def deploy_breadcrumb(self) -> BreadcrumbDrop:
+        return BreadcrumbDrop(False, self._name, None, 0, f"{self._name} carries no breadcrumbs on a graph world")
+
+    @property
+    def payload(self) -> None:
+        return None
 
     # ---- NetworkView --------------------------------------------------------------
     def topology(self) -> dict[str, Any]:

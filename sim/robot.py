@@ -85,11 +85,6 @@ class SimRobot(RobotBody):
         return self._yaw
 
     @property
-    def view_up_deg(self) -> float:
-        lidar = self._platform.lidar
-        return lidar.pitch_deg + lidar.vertical_fov_deg / 2
-
-    @property
     def onboard_map(self) -> VoxelMap:
         return self._map
 
