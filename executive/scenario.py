@@ -167,18 +167,18 @@ def _world_backend(doc: YamlDict, path: Path) -> type[WorldBackend]:
     return backend
 
 
-def _team(doc: YamlDict, path: Path, base_types: set[type], tree_types: set[type]) -> TeamSpec:
+def _team(doc: YamlDict, path: Path, tree_types: set[type]) -> TeamSpec:
     """The scenario's team strategy with its checked parameters. Without ``team:``,
-    the strategy the base station tree implies (with a deprecation warning that names
+    the strategy whose behaviours the trees use (with a deprecation warning that names
     the key to add), else the default. Trees whose nodes need another strategy than
     the one named are a mistake."""
     team = doc.get("team")
     if team is None:
-        name = implied_strategy(base_types)
+        name = implied_strategy(tree_types)
         if name is None:
             return TeamSpec(TEAM_STRATEGIES[DEFAULT_STRATEGY], {})
         warnings.warn(DelveDeprecation(
-            f"{path}: no 'team:' key; the base station tree implies strategy {name!r}. "
+            f"{path}: no 'team:' key; the trees use behaviours of strategy {name!r}. "
             f"Add 'team: {{strategy: {name}}}' (a scenario without it will be an independent team)"), stacklevel=2)
         return TeamSpec(TEAM_STRATEGIES[name], {})
     name = team["strategy"]
@@ -237,13 +237,12 @@ def load_scenario(path: str | Path) -> Scenario:
                                 line=line, start_line=r.key_line("start")))
 
     base = doc.get("base_station", {})
-    base_tree, base_types = None, set()
+    base_tree = None
     if "tree" in base:
         base_tree = (path.parent / base["tree"]).resolve()
         if not base_tree.exists():
             raise DelveError(f"base station tree file not found: {base['tree']}", path, base.key_line("tree"))
-        base_types = check_tree(base_tree)
-        tree_types |= base_types
+        tree_types |= check_tree(base_tree)
     supervisor = load_supervisor(doc.get("supervisor"), path, {r.name: r.breadcrumbs for r in robots})
     faults = []
     for i, f in enumerate(doc.get("faults", [])):
@@ -255,7 +254,7 @@ def load_scenario(path: str | Path) -> Scenario:
         faults.append(Fault(float(f["at_s"]), f["robot"], f["kind"], float(f.get("duration_s", 0.0))))
     values = {k: doc.get(k, v) for k, v in DEFAULTS.items()}
     backend.check(doc, path, base_tree is not None)
-    team = _team(doc, path, base_types, tree_types)
+    team = _team(doc, path, tree_types)
     if team.strategy.NEEDS_BASE_TREE and base_tree is None:
         name = next(n for n, s in TEAM_STRATEGIES.items() if s is team.strategy)
         raise DelveError(f"team strategy {name!r} needs a base station tree (base_station: tree: ...)", path,
