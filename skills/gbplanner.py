@@ -46,8 +46,10 @@ class PlannerService:
 
 def robot_config(robot: Robot, overrides: dict[str, Any] | None = None) -> GBPlannerConfig:
     """GBPlanner2's configuration for ``robot``: the Table I preset of its platform
-    (``legged``: ANYmal C, ``aerial``: RMF-Obelix), adapted to its mobility limits and
-    remaining endurance, then ``overrides`` (GBPlannerConfig field names) on top.
+    (``legged``: ANYmal C, ``aerial``: RMF-Obelix), adapted to its mobility limits,
+    then ``overrides`` (GBPlannerConfig field names) on top. The planner reads the
+    robot's remaining endurance at each iteration (T_end is the robot's, not the
+    configuration's).
 
     The collision box's horizontal sides are the robot's diameter less one voxel of
     its map: the planner rounds the box out to whole voxels on each side (a 0.8 m box
@@ -62,7 +64,6 @@ def robot_config(robot: Robot, overrides: dict[str, Any] | None = None) -> GBPla
         radius_m=radius,
         max_inclination_deg=mob.max_inclination_deg,
         max_step_m=mob.max_step_m,
-        endurance_s=max(robot.endurance_remaining_s, 1.0),
     )
     return cfg.replace(**overrides) if overrides else cfg
 
@@ -86,7 +87,7 @@ def gbplanner(ctx: AgentContext, robot: Robot, overrides: dict[str, Any] | None 
         svc = ctx.services[SERVICE] = PlannerService(planner, np.random.default_rng(stable_seed(seed, ctx.name)),
                                                      dict(overrides or {}))
     elif overrides and overrides != svc.overrides:
-        cfg = robot_config(robot, overrides).replace(endurance_s=svc.planner.config.endurance_s)
+        cfg = robot_config(robot, overrides)
         svc.planner.config = cfg
         svc.planner.local_planner = ShrinkingLocalPlanner(cfg)
         svc.planner.global_planner.config = cfg

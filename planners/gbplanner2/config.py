@@ -66,8 +66,6 @@ class GBPlannerConfig:
     max_step_m: float = 0.3
     #: Speed used to turn path lengths into times (homing, repositioning).
     speed_mps: float = 1.0
-    #: T_end, the robot's total endurance.
-    endurance_s: float = 70.0 * 60.0
 
     # --- local bounding box (adaptive, PCA of the local point cloud) --------------
     #: mu_V: radius of the local point cloud whose PCA orients the local bounding box.
@@ -205,7 +203,6 @@ class GBPlannerConfig:
         radius_m: float | None = None,
         max_inclination_deg: float | None = None,
         max_step_m: float | None = None,
-        endurance_s: float | None = None,
     ) -> GBPlannerConfig:
         """A copy adapted to a robot's own limits (e.g. the robot interface's Mobility).
 
@@ -223,8 +220,6 @@ class GBPlannerConfig:
             changes["max_inclination_deg"] = float(max_inclination_deg)
         if max_step_m is not None and self.is_legged and max_step_m > 0:
             changes["max_step_m"] = float(max_step_m)
-        if endurance_s is not None:
-            changes["endurance_s"] = float(endurance_s)
         return self.replace(**changes)
 
     @property
@@ -270,7 +265,7 @@ def _problems(c: GBPlannerConfig) -> list[str]:
         out.append(f"robot_type must be one of {ROBOT_TYPES}, got {c.robot_type!r}")
     for name in (
         "voxel_size_m", "body_height_m", "ground_search_depth_m", "inclination_window_m",
-        "max_step_m", "speed_mps", "endurance_s", "local_pointcloud_range_m",
+        "max_step_m", "speed_mps", "local_pointcloud_range_m",
         "local_pointcloud_spacing_m", "bounding_box_size_max_m", "edge_length_max_m",
         "neighbour_radius_m", "sensor_range_m", "gain_ray_resolution_horizontal_deg",
         "gain_ray_resolution_vertical_deg", "gain_ray_step_voxels", "traverse_length_max_m",
@@ -325,7 +320,6 @@ ANYMAL_C: dict[str, Any] = {
     "sensor_range_m": 30.0,
     "clustering_radius_m": 0.0,
     "leaf_only_gain": False,
-    "endurance_s": 70.0 * 60.0,
     "hanging_vertex_penalty": 5.0,
     "robot_box_size_m": (0.8, 0.8, 0.2),
     "body_height_m": 0.5,
@@ -345,7 +339,6 @@ RMF_OBELIX: dict[str, Any] = {
     "sensor_range_m": 30.0,
     "clustering_radius_m": 1.0,
     "leaf_only_gain": True,
-    "endurance_s": 8.5 * 60.0,
     "hanging_vertex_penalty": 5.0,
     "robot_box_size_m": (0.6, 0.6, 0.4),
     "speed_mps": 1.0,

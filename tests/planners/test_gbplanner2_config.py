@@ -13,7 +13,6 @@ def test_anymal_c_preset_matches_table_1():
     assert (c.sensor_fov_horizontal_deg, c.sensor_fov_vertical_deg) == (360.0, 30.0)
     assert c.sensor_range_m == 30.0
     assert c.clustering_radius_m == 0.0 and not c.clustering_enabled
-    assert c.endurance_s == 70 * 60
     assert c.hanging_vertex_penalty == 5.0
     assert math.isclose(c.hanging_gain_factor, math.exp(-5.0))
     assert c.local_pointcloud_range_m == 50.0  # mu_V
@@ -27,7 +26,6 @@ def test_rmf_obelix_preset_matches_table_1():
     assert (c.sensor_fov_horizontal_deg, c.sensor_fov_vertical_deg) == (360.0, 90.0)
     assert c.sensor_range_m == 30.0
     assert c.clustering_radius_m == 1.0 and c.clustering_enabled
-    assert c.endurance_s == 8.5 * 60
     assert c.hanging_vertex_penalty == 5.0
 
 

@@ -56,7 +56,7 @@ def test_robot_config_takes_the_platform_preset_and_the_robot_limits(half_mapped
     legged = FakeRobot(grid, body(a, 3.0), endurance_s=1200.0)
     cfg = robot_config(legged)
     assert cfg.robot_type == "legged" and cfg.num_vertices_max == 1000 and cfg.sensor_fov_vertical_deg == 30.0
-    assert cfg.max_inclination_deg == 35.0 and cfg.endurance_s == 1200.0 and cfg.clustering_radius_m == 0.0
+    assert cfg.max_inclination_deg == 35.0 and cfg.clustering_radius_m == 0.0
     assert cfg.robot_box_size_m[:2] == pytest.approx((0.6, 0.6))  # 0.8 m less a voxel: rounded out, 3 voxels
     aerial = FakeRobot(grid, body(a, 3.0), platform="aerial")
     cfg = robot_config(aerial, {"num_vertices_max": 300})
