@@ -39,6 +39,7 @@ bench: setup
 	$(BIN)/python bench/sim_speed.py
 	$(BIN)/python bench/bt_overhead.py
 	$(BIN)/python bench/gbplanner.py
+	$(BIN)/python bench/hot_paths.py
 
 # Regenerate the tree JSON Schema and docs/nodes.md from the node registry, into this
 # source tree (the generator writes only where it is told, never into site-packages).

@@ -1,4 +1,5 @@
-"""Shared helpers for scenario tests: run a scenario file to the end."""
+"""Shared helpers for scenario tests: run a scenario file to the end. Every test here
+is marked ``slow`` (``pytest -m "not slow"`` leaves them out)."""
 from pathlib import Path
 
 import pytest
@@ -21,3 +22,12 @@ def run_scenario(path: Path, out: Path | None = None, **kw) -> tuple[Mission, di
 @pytest.fixture(scope="session")
 def data_dir() -> Path:
     return DATA
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """Mark every scenario test ``slow`` (a hook in this conftest sees every collected
+    test, so it marks only those under this folder)."""
+    here = Path(__file__).parent
+    for item in items:
+        if here in item.path.parents:
+            item.add_marker(pytest.mark.slow)
