@@ -5,13 +5,18 @@ the intermittent-connectivity integer program, Problem 1 (pre-exploration) and
 Problem 2 (post-exploration), clustering for large networks, plans as plain data
 and the plan validator.
 """
-from .ilp import (ConnectivityProblem, InfeasibleProblem, PlanningError, SolverOptions, SolverTimeout,
-                  available_solver, information_distance, plan_cost, reconstruct_communications,
-                  solve_connectivity)
+from .cycle import exploration_tasks, plan_cycle
+from .distances import information_distance
+from .errors import InfeasibleProblem, PlanningError, SolverTimeout
+from .ilp import plan_cost, solve_connectivity
+from .ilp_problem import ConnectivityProblem, SolverOptions
+from .ilp_solvers import available_solver
 from .network import (MCNetwork, Robot, add_team, dead_ends, network_from_dict, tunnel_network_graph)
 from .plan import MASTER, Communication, CyclePlan, ExplorationTask, Plan, Requirement, Step
-from .problems import (FrontierReward, exploration_tasks, plan_cycle, solve_post_exploration,
-                       solve_pre_exploration)
+from .plan_extraction import reconstruct_communications
+from .post_exploration import solve_post_exploration
+from .pre_exploration import solve_pre_exploration
+from .rewards import FrontierReward
 from .validator import Violation, validate_plan
 
 __all__ = [

@@ -34,11 +34,17 @@ from typing import Callable, Iterable, Mapping
 
 import networkx as nx
 
-from .ilp import InfeasibleProblem, PlanningError, SolverOptions
+from .budget import PRE_SHARE, Budget
+from .errors import InfeasibleProblem, PlanningError
+from .greedy import greedy_pre_plan
+from .ilp_problem import SolverOptions
 from .network import MCNetwork
-from .plan import Communication, CyclePlan, ExplorationTask, Plan, Requirement
-from .problems import (DEFAULT_MIN_EXPLORATION_STEPS, PRE_SHARE, FrontierReward, _Budget, _masters,
-                       _robot_sets, greedy_pre_plan, solve_post_exploration, solve_pre_exploration)
+from .plan import (DEFAULT_MIN_EXPLORATION_STEPS, Communication, CyclePlan, ExplorationTask, Plan, Requirement,
+                   worst_gap)
+from .post_exploration import solve_post_exploration
+from .pre_exploration import solve_pre_exploration
+from .rewards import FrontierReward
+from .roles import master_robots, robot_sets
 
 #: Default largest number of locations in a cluster before it is cut.
 DEFAULT_MAX_CLUSTER_LOCATIONS = 24
@@ -251,8 +257,8 @@ def plan_cycle_clustered(network: MCNetwork, *, positions: Mapping[str, str] | N
     planned on the whole network instead (``meta["post_clustered"]`` is False).
     """
     t0 = time.perf_counter()
-    pos, st, ex = _robot_sets(network, positions, static, explorers)
-    ms = _masters(network, pos, masters)
+    pos, st, ex = robot_sets(network, positions, static, explorers)
+    ms = master_robots(network, pos, masters)
     fr = set(network.frontiers if frontiers is None else frontiers)
     base_station = network.base_station
     if base_station is None or base_station not in pos:
@@ -264,7 +270,7 @@ def plan_cycle_clustered(network: MCNetwork, *, positions: Mapping[str, str] | N
         if not any(nx.has_path(network.mobility, pos[r], s) for r in mobile_ex):
             raise InfeasibleProblem(f"frontier {s} cannot be reached by any capable robot")
     cs = build_clusters(network, pos, fr, pos[base_station], st, ex, max_cluster_locations)
-    budget = _Budget(options or SolverOptions())
+    budget = Budget(options or SolverOptions())
     pre, pre_done = _clustered_pre(network, cs, pos, ms, st, ex, reward, evacuation_reward, max_horizon,
                                    budget.options(PRE_SHARE))
     post_pos = pre.final_positions()
@@ -293,7 +299,7 @@ def plan_cycle_clustered(network: MCNetwork, *, positions: Mapping[str, str] | N
         "idle_clusters": sorted(k for k in C if C[k].idle), "post_clustered": post_clustered,
         "min_exploration_steps": min_exploration_steps, "post_start_step": offset,
         "solve_time_s": round(time.perf_counter() - t0, 4),
-        "gap": _gap([pre, post])})
+        "gap": worst_gap([pre, post])})
 
 
 def _solve_all(jobs: list[tuple[str, float, Callable[[SolverOptions], Plan]]],
@@ -302,7 +308,7 @@ def _solve_all(jobs: list[tuple[str, float, Callable[[SolverOptions], Plan]]],
     the interpreter while it works). A job (name, weight, solve) may use the share of
     the time left that its weight has among the jobs not yet started (times the
     number of workers); raises the first job's error, if any."""
-    budget = _Budget(opts)
+    budget = Budget(opts)
     workers = max(1, min(int(opts.workers or 1), len(jobs)))
     lock = threading.Lock()
     waiting = {name: w for name, w, _ in jobs}
@@ -484,20 +490,13 @@ def _clustered_post(network, cs: ClusterStructure, pre: Plan, post_pos, post_mas
     return post, join
 
 
-def _gap(plans: list[Plan]):
-    gaps = [p.meta.get("gap") for p in plans]
-    if any(g is None for g in gaps):
-        return None
-    return max(gaps, default=0.0)
-
-
 def _merged_meta(plans: Iterable[Plan]) -> dict:
     plans = list(plans)
     return {"clusters": len(plans),
             "cost": round(sum(p.meta.get("cost", 0.0) for p in plans), 6),
             "reward": round(sum(p.meta.get("reward", 0.0) for p in plans), 6),
             "objective": round(sum(p.meta.get("objective", 0.0) for p in plans), 6),
-            "gap": _gap(plans),
+            "gap": worst_gap(plans),
             "status": "optimal" if all(p.meta.get("status") in ("optimal", "trivial") for p in plans) else "feasible",
             "solve_time_s": round(sum(p.meta.get("solve_time_s", 0.0) for p in plans), 4),
             "solver": next((p.meta.get("solver") for p in plans if p.meta.get("solver")), None)}

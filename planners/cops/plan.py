@@ -229,6 +229,18 @@ def idle_plan(positions: Mapping[str, str], masters: Iterable[str], phase: str,
                       "gap": 0.0, "solve_time_s": 0.0, "solver": None})
 
 
+def worst_gap(plans: Iterable[Plan]) -> float | None:
+    """The largest optimality gap (``meta["gap"]``) of ``plans``; None when one is unknown."""
+    gaps = [p.meta.get("gap") for p in plans]
+    if any(g is None for g in gaps):
+        return None
+    return max(gaps, default=0.0)
+
+
+#: Default minimum exploration time of a cycle, in plan steps (ΔT each).
+DEFAULT_MIN_EXPLORATION_STEPS = 4
+
+
 @dataclass(frozen=True)
 class ExplorationTask:
     """A robot's exploration phase: from ``frontier`` with Algorithm 1 index ``index``,

@@ -13,10 +13,13 @@ from __future__ import annotations
 
 from typing import Iterable, Mapping
 
-from .ilp import ConnectivityProblem, InfeasibleProblem, SolverOptions, SolverTimeout, solve_connectivity
+from .errors import InfeasibleProblem, SolverTimeout
+from .greedy import greedy_pre_plan
+from .horizon import horizon_of
+from .ilp import solve_connectivity
+from .ilp_problem import ConnectivityProblem, SolverOptions
 from .network import MCNetwork
 from .plan import MASTER, Communication, Plan, idle_plan
-from .problems import horizon_of, greedy_pre_plan
 
 #: Reward for each robot brought home; larger than any route's mobility cost.
 DEFAULT_HOME_REWARD = 1000.0

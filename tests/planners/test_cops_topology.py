@@ -2,7 +2,7 @@
 import pytest
 
 from delve.planners.cops import validate_plan
-from delve.planners.cops.problems import greedy_pre_plan
+from delve.planners.cops.greedy import greedy_pre_plan
 from delve.planners.cops.plan import MASTER, Communication, Plan
 from delve.planners.cops.recall import _hand_m_at_base, solve_recall
 from delve.planners.cops.topology import Topology, team_network
