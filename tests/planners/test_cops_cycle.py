@@ -1,0 +1,24 @@
+"""delve.planners.cops.cycle: one COPS cycle without clustering."""
+from delve.planners.cops import SolverOptions, plan_cycle, validate_plan
+
+from .cops_networks import fork, team
+
+
+def test_a_cycle_passes_the_validator():
+    net = fork(team(2))
+    cyc = plan_cycle(net, clustering=False)
+    assert validate_plan(net, cyc.pre) == []
+    assert validate_plan(net.with_positions(cyc.pre.final_positions()), cyc.post) == []
+    assert set(cyc.exploration) == set(cyc.pre.explore)
+    assert all(task.steps >= 4 for task in cyc.exploration.values())
+
+
+def test_greedy_plans_bound_the_horizon_and_warm_start_the_solver():
+    net = fork(team(4))
+    cyc = plan_cycle(net, clustering=False, options=SolverOptions(time_limit_s=2, total_time_limit_s=4))
+    assert validate_plan(net, cyc.pre) == []
+    # trimmed after the last action: the last step moves someone or sends something
+    T = cyc.pre.horizon
+    last_moves = any(tr[T - 1] != tr[T] for tr in cyc.pre.trajectories.values())
+    assert last_moves or any(c.t == T for c in cyc.pre.communications)
+    assert cyc.pre.meta["status"] in ("optimal", "feasible") and cyc.meta["solve_time_s"] < 8
