@@ -39,7 +39,7 @@ def solve_recall(network: MCNetwork, *, positions: Mapping[str, str], masters: I
     away = [r for r in mobile if positions[r] != base]
     if not away:  # everyone is home: m is handed to each robot there, and that is all
         plan = idle_plan(positions, ms, "recall")
-        _hand_m_at_base(plan, base, mobile)
+        hand_m_at_base(plan, base, mobile)
         plan.meta["stranded"] = []
         return plan
     for r in away:
@@ -78,13 +78,13 @@ def solve_recall(network: MCNetwork, *, positions: Mapping[str, str], masters: I
             break
     if best is None:
         raise InfeasibleProblem(f"no recall plan within horizon T={upper}")
-    _hand_m_at_base(best, base, mobile)
+    hand_m_at_base(best, base, mobile)
     best.meta["stranded"] = sorted(r for r in mobile if best.location(r, best.horizon) != base)
     best.explore = {}
     return best
 
 
-def _hand_m_at_base(plan: Plan, base: str, mobile: list[str]) -> None:
+def hand_m_at_base(plan: Plan, base: str, mobile: list[str]) -> None:
     """Robots at the base at T that m has not reached get it there at T (a solve
     stopped by its time limit may leave out such a reward)."""
     T, holders = plan.horizon, plan.master_receivers()

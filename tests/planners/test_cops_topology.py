@@ -4,7 +4,7 @@ import pytest
 from delve.planners.cops import validate_plan
 from delve.planners.cops.greedy import greedy_pre_plan
 from delve.planners.cops.plan import MASTER, Communication, Plan
-from delve.planners.cops.recall import _hand_m_at_base, solve_recall
+from delve.planners.cops.recall import hand_m_at_base, solve_recall
 from delve.planners.cops.topology import Topology, team_network
 
 
@@ -86,7 +86,7 @@ def test_recall_hands_m_at_the_end_to_robots_home_without_it():
     net = team_network(chain(4, 4), "s0", "base", {"r1": "s0", "r2": "s1"})
     plan = Plan(horizon=3, trajectories={"base": ["s0"] * 4, "r1": ["s0"] * 4, "r2": ["s1", "s0", "s0", "s0"]},
                 communications=[Communication(0, "base", "r2", MASTER)], masters=["base"], phase="recall")
-    _hand_m_at_base(plan, "s0", ["r1", "r2"])
+    hand_m_at_base(plan, "s0", ["r1", "r2"])
     assert plan.communications[-1] == Communication(3, "base", "r1", MASTER)
     assert plan.master_receivers() == {"base", "r1", "r2"} and not validate_plan(net, plan)
 
