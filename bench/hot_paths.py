@@ -32,7 +32,8 @@ from pathlib import Path
 import networkx as nx
 import numpy as np
 import open3d as o3d
-from delve.planners.cops import PlanningError, Robot, SolverOptions, plan_cycle, tunnel_network_graph, validate_plan
+from delve.planners.cops import (PlanningError, Robot, SolverOptions, plan_cycle, tunnel_network_graph,
+                                 validate_plan)
 from delve.sim.world import World
 from delve.sim.worldgen_geometry import VoxelCanvas, carve_chamber, carve_tunnel, free_space_mesh
 
@@ -108,7 +109,8 @@ def bench_raycast(runs: int) -> list[str]:
         f"(interleaved), median",
         "",
         f"{'':<42}{'ms':>8}{'ratio':>8}",
-        f"{'World.cast_rays':<42}{ms:>8.2f}{ratio(rows, bases):>8.2f}   (goal < {RAYCAST_GOAL_MS:g} ms: {verdict})",
+        f"{'World.cast_rays':<42}{ms:>8.2f}{ratio(rows, bases):>8.2f}"
+        f"   (goal < {RAYCAST_GOAL_MS:g} ms: {verdict})",
         f"{'baseline: open3d RaycastingScene.cast_rays':<42}{base_ms:>8.2f}{1.0:>8.2f}",
     ]
 
@@ -156,7 +158,8 @@ class Cycles:
             self.failed += 1
             return time.perf_counter() - start, None
         wall = time.perf_counter() - start
-        if validate_plan(net, cyc.pre) or validate_plan(net.with_positions(cyc.pre.final_positions()), cyc.post):
+        after = net.with_positions(cyc.pre.final_positions())
+        if validate_plan(net, cyc.pre) or validate_plan(after, cyc.post):
             self.invalid += 1
         return wall, cyc
 
@@ -194,15 +197,17 @@ def bench_cops(runs: int) -> list[str]:
     spread = {f"r{i}": ("s0" if i <= 3 else rng.choice(larger)) for i in range(1, 11)}
     base = cycles.one(small, {"r1": "s0"})
     rows = [
-        ("20 robots at the base, 5 known locations", cycles.one(small, {f"r{i}": "s0" for i in range(1, 21)})),
+        ("20 robots at the base, 5 known locations",
+         cycles.one(small, {f"r{i}": "s0" for i in range(1, 21)})),
         ("10 robots spread, 60 known locations", cycles.one(set(larger), spread)),
         ("growing network, 1 robot (slowest of 4)", cycles.growing(1)),
         ("growing network, 20 robots (slowest of 4)", cycles.growing(20)),
     ]
     base()  # warm up (imports, solver start-up)
     lines = [
-        f"COPS plan_cycle, limits {OPTS.time_limit_s:g} s per program, {OPTS.probe_time_limit_s:g} s per probe, "
-        f"{OPTS.total_time_limit_s:g} s per cycle; {runs} runs (interleaved with the baseline), median",
+        f"COPS plan_cycle, limits {OPTS.time_limit_s:g} s per program, "
+        f"{OPTS.probe_time_limit_s:g} s per probe, {OPTS.total_time_limit_s:g} s per cycle; "
+        f"{runs} runs (interleaved with the baseline), median",
         "",
         f"{'':<44}{'s':>8}{'ratio':>8}",
     ]
@@ -215,11 +220,13 @@ def bench_cops(runs: int) -> list[str]:
         verdict = "ok" if s < CYCLE_GOAL_S else "ABOVE GOAL"
         if cycles.failed > failed:  # the time until plan_cycle gave up
             verdict = f"NO PLAN in {cycles.failed - failed} of {runs} runs"
-        lines.append(f"{label:<44}{s:>8.2f}{ratio(times, bases):>8.1f}   (goal < {CYCLE_GOAL_S:g} s: {verdict})")
-    lines.append(f"{'baseline: 1 robot at the base, 5 known':<44}{statistics.median(base_times):>8.3f}{1.0:>8.1f}")
+        lines.append(f"{label:<44}{s:>8.2f}{ratio(times, bases):>8.1f}"
+                     f"   (goal < {CYCLE_GOAL_S:g} s: {verdict})")
+    base_s = statistics.median(base_times)
+    lines.append(f"{'baseline: 1 robot at the base, 5 known':<44}{base_s:>8.3f}{1.0:>8.1f}")
     lines.append("")
-    lines.append(f"plans failing the validator: {cycles.invalid}; cycles that found no plan within the limits: "
-                 f"{cycles.failed}")
+    lines.append(f"plans failing the validator: {cycles.invalid}; "
+                 f"cycles that found no plan within the limits: {cycles.failed}")
     return lines
 
 

@@ -210,7 +210,8 @@ class FakeRobot:
         if self.breadcrumbs <= 0:
             return FakeDrop(False, None, 0, f"{self.name} has no breadcrumbs left")
         if not self.has_ground:
-            return FakeDrop(False, None, self.breadcrumbs, f"{self.name} has no ground below to drop a breadcrumb on")
+            return FakeDrop(False, None, self.breadcrumbs,
+                            f"{self.name} has no ground below to drop a breadcrumb on")
         self.breadcrumbs -= 1
         self.drops.append(self.position)
         return FakeDrop(True, f"{self.name}_crumb{len(self.drops)}", self.breadcrumbs)

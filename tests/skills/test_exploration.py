@@ -83,7 +83,8 @@ def test_on_a_map_that_never_changes_every_frontier_is_visited_then_exploration_
     assert min(xs) < a[0] + 20.0 and max(xs) > a[0] + 29.0  # both ends visited
 
 
-@pytest.mark.parametrize("text", ["type: ExploreFrontiers", "type: ExploreFrontiers\nmin_cluster_voxels: 100000"])
+@pytest.mark.parametrize("text", ["type: ExploreFrontiers",
+                                  "type: ExploreFrontiers\nmin_cluster_voxels: 100000"])
 def test_nothing_to_explore_succeeds_at_once(half_mapped, text):
     """A tunnel mapped all along (closed at both ends), or frontiers all too small."""
     grid, a, _ = syn.straight_tunnel(length_m=24) if text == "type: ExploreFrontiers" else half_mapped

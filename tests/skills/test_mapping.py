@@ -36,10 +36,10 @@ def robot(tunnel):
 def base_station(grid):
     """The base station's agent: its radio and its (empty) map of the robots' world."""
     log: list = []
+    base_map = VoxelMap(grid.occupancy.shape, grid.origin, grid.voxel_size_m)
     ctx = AgentContext(name="base", namespace="/base", clock=Clock(),
                        log=lambda event, **fields: log.append((event, fields)),
-                       services={"radio": FakeRadio("base"), "map": VoxelMap(grid.occupancy.shape, grid.origin,
-                                                                               grid.voxel_size_m)})
+                       services={"radio": FakeRadio("base"), "map": base_map})
     ctx.events = log  # type: ignore[attr-defined]
     return ctx
 
@@ -163,8 +163,9 @@ def test_other_messages_are_logged_for_the_supervisor(tunnel):
     grid, _, _ = tunnel
     base = base_station(grid)
     merge = build("type: MergeMaps", base)
-    base.services["radio"].deliver("r1", "goal_unreachable", {"goal": [1, 2, 3], "reason": "no_path"}, sent_s=7.5)
-    base.services["radio"].deliver("r2", MAP_DELTA, {"flat": np.array([0]), "values": np.array([FREE], np.int8)})
+    radio = base.services["radio"]
+    radio.deliver("r1", "goal_unreachable", {"goal": [1, 2, 3], "reason": "no_path"}, sent_s=7.5)
+    radio.deliver("r2", MAP_DELTA, {"flat": np.array([0]), "values": np.array([FREE], np.int8)})
     merge.tick_once()
     assert merge.status == Status.RUNNING
     (logged,) = events(base, "base_received")

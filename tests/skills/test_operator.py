@@ -79,8 +79,10 @@ CASES = {
     "home": ({}, {"mode": "home"}),
     "cancel": ({}, {"mode": "idle"}),
     "relocate": ({}, {"mode": "relocate"}),
-    "scan": ({"point": [12.0, 6.0, 1.5]}, {"inspection_request": {"point": [12.0, 6.0, 1.5], "requested_s": 42.0}}),
-    "goto": ({"goal": [20.0, 6.0, 1.5]}, {"mode": "goto", "goal": [20.0, 6.0, 1.5], "goal_source": "supervisor"}),
+    "scan": ({"point": [12.0, 6.0, 1.5]},
+             {"inspection_request": {"point": [12.0, 6.0, 1.5], "requested_s": 42.0}}),
+    "goto": ({"goal": [20.0, 6.0, 1.5]},
+             {"mode": "goto", "goal": [20.0, 6.0, 1.5], "goal_source": "supervisor"}),
     "drop_breadcrumb": ({}, {"breadcrumb_request": True}),
 }
 
@@ -100,7 +102,8 @@ def test_each_command_writes_its_state_and_logs_a_trigger(agent, name):
     assert node.status == Status.RUNNING
     assert state() == {**before, **writes, "last_command": name}
     (logged,) = events(ctx, "operator_command")
-    assert logged == {"agent": "r1", "node": "ProcessOperatorCommands", "trigger": True, "command": name, **args}
+    assert logged == {"agent": "r1", "node": "ProcessOperatorCommands", "trigger": True, "command": name,
+                      **args}
 
 
 def test_explore_without_a_budget_clears_the_last_budget(agent):
