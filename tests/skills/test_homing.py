@@ -1,5 +1,7 @@
-"""delve.skills.homing: EnduranceLow and ReturnHome, built by their YAML type names and
-ticked on the fake robot (their behaviour only: what they write, command and log)."""
+"""delve.skills.homing: EnduranceLow, and Home along the navigation graph of the onboard
+map (``path_source: navigator``, formerly ``ReturnHome``), built from YAML and ticked on
+the fake robot (their behaviour only: what they write, command and log). Home along
+GBPlanner2's graph is tested in test_gbplanner.py."""
 from __future__ import annotations
 
 import numpy as np
@@ -8,8 +10,10 @@ import pytest
 from delve.planners.gbplanner2 import synthetic as syn
 from py_trees.common import Status
 
-from .fakes import FakeRobot, bb, body, build, events, make_ctx, run
+from .fakes import TREES, FakeRobot, bb, body, build, events, make_ctx, run
 
+#: Home on the shortest path of the onboard map's navigation graph.
+RETURN_HOME = "type: Home\npath_source: navigator"
 HOME = np.array([5.0, 4.0, 1.5])
 #: The far end of the U, 6 m from HOME as the crow flies and 46 m on foot.
 FAR_SIDE = np.array([5.0, 12.0, 1.5])
@@ -127,13 +131,13 @@ def test_endurance_low_is_never_late_for_a_robot_walking_away():
     assert events(ctx, "endurance_low")[0]["trigger"] is True
 
 
-# ------------------------------------------------------------------------ ReturnHome
+# ------------------------------------------------------- Home, path_source: navigator
 
 
 def test_return_home_walks_round_the_u_and_writes_returned_home(u_tunnel):
     robot = FakeRobot(u_tunnel, FAR_SIDE, home=HOME)
     ctx = make_ctx(robot)
-    homing = build("type: ReturnHome", ctx)
+    homing = build(RETURN_HOME, ctx)
     homing.tick_once()
     assert homing.status == Status.RUNNING
     (path,) = robot.paths
@@ -156,13 +160,13 @@ def test_return_home_at_home_succeeds_at_once(tunnel):
     home = body(a, 2.0)
     robot = FakeRobot(grid, home + np.array([0.8, 0.0, 0.0]), home=home)
     ctx = make_ctx(robot)
-    homing = build("type: ReturnHome\ntolerance_m: 1.0", ctx)
+    homing = build(RETURN_HOME + "\ntolerance_m: 1.0", ctx)
     homing.tick_once()
     assert homing.status == Status.SUCCESS and robot.paths == []
     assert bb("returned_home") is True and events(ctx, "home_reached")
     py_trees.blackboard.Blackboard.clear()
     ctx = make_ctx(robot)
-    strict = build("type: ReturnHome\ntolerance_m: 0.5", ctx)
+    strict = build(RETURN_HOME + "\ntolerance_m: 0.5", ctx)
     assert run(strict, ctx, robot, dt_s=0.25) == Status.SUCCESS
     assert len(robot.paths) == 1 and np.linalg.norm(robot.position - home) <= 0.5
 
@@ -173,7 +177,7 @@ def test_return_home_replans_after_a_blocked_path(tunnel):
     robot = FakeRobot(grid, body(a, 20.0), home=home)
     robot.block_at, robot.block_radius_m = body(a, 15.0), 0.5
     ctx = make_ctx(robot)
-    homing = build("type: ReturnHome", ctx)
+    homing = build(RETURN_HOME, ctx)
     for _ in range(10):  # walks into the block
         homing.tick_once()
         robot.step(1.0)
@@ -193,7 +197,7 @@ def test_return_home_gives_up_after_max_replans(tunnel, max_replans):
     robot = FakeRobot(grid, body(a, 20.0), home=body(a, 2.0))
     robot.block_at, robot.block_radius_m = body(a, 15.0), 2.5  # the tunnel's whole width
     ctx = make_ctx(robot)
-    homing = build(f"type: ReturnHome\nmax_replans: {max_replans}", ctx)
+    homing = build(RETURN_HOME + f"\nmax_replans: {max_replans}", ctx)
     assert run(homing, ctx, robot) == Status.FAILURE
     assert len(robot.paths) == max_replans + 1
     (failed,) = events(ctx, "homing_failed")
@@ -208,7 +212,7 @@ def test_return_home_fails_when_home_cannot_be_reached(tunnel):
     grid, a, _ = tunnel
     robot = FakeRobot(grid, body(a, 15.0), home=body(a, 2.0) + np.array([0.0, 0.0, 30.0]))
     ctx = make_ctx(robot)
-    homing = build("type: ReturnHome\nmax_replans: 2", ctx)
+    homing = build(RETURN_HOME + "\nmax_replans: 2", ctx)
     statuses = []
     for _ in range(20):
         homing.tick_once()
@@ -222,11 +226,26 @@ def test_return_home_fails_when_home_cannot_be_reached(tunnel):
     assert events(ctx, "homing_failed") and bb("returned_home") is not True
 
 
+def test_the_former_name_return_home_still_works_and_says_what_to_write(u_tunnel, capsys):
+    walked = []
+    for text in (RETURN_HOME, "type: ReturnHome"):
+        py_trees.blackboard.Blackboard.clear()
+        robot = FakeRobot(u_tunnel, FAR_SIDE, home=HOME)
+        ctx = make_ctx(robot)
+        # The notice is told once per place in a file: a place no other test builds at.
+        homing = build(text, ctx, within=TREES / "test_homing_alias")
+        assert run(homing, ctx, robot) == Status.SUCCESS and bb("returned_home") is True
+        walked.append(robot.paths)
+    assert len(walked[0]) == len(walked[1]) == 1 and np.array_equal(walked[0][0], walked[1][0])
+    err = capsys.readouterr().err
+    assert "'ReturnHome' is deprecated" in err and "path_source: navigator" in err
+
+
 def test_return_home_interrupted_stops_only_its_own_motion(tunnel):
     grid, a, _ = tunnel
     robot = FakeRobot(grid, body(a, 20.0), home=body(a, 2.0))
     ctx = make_ctx(robot)
-    homing = build("type: ReturnHome", ctx)
+    homing = build(RETURN_HOME, ctx)
     homing.tick_once()
     robot.step(1.0)
     homing.stop(Status.INVALID)  # a higher-priority branch took over
