@@ -1,0 +1,88 @@
+"""The base of the COPS behaviours: the agent's COPS state on the blackboard, its
+radio, and driving to a location through the robot's NetworkView."""
+from __future__ import annotations
+
+from typing import Any
+
+from py_trees.common import Status
+
+from ..base import AgentContext, Param, Skill
+from ..robot import NetworkView, PathStatus
+from .state import KIND, CopsState, collect_own_map
+
+STATE_KEY = Param(str, "cops", "blackboard key of the agent's COPS state", key=True)
+
+
+def network_view(ctx: AgentContext) -> NetworkView | None:
+    """The robot's NetworkView (service ``network_view``, which the world backend
+    makes for each robot of a COPS team); None at the base station."""
+    return ctx.services.get("network_view")
+
+
+class CopsSkill(Skill):
+    """Base of the COPS behaviours: the agent's state and radio."""
+
+    ABSTRACT = True
+    PARAMS = {"state": STATE_KEY}
+    #: The location :meth:`drive_to` last sent the robot to, and the last one where
+    #: it found the robot as near the position as it can get.
+    _driving: str | None = None
+    _settled: str | None = None
+
+    def reset_drive(self) -> None:
+        """Forget earlier drives (when the behaviour starts afresh)."""
+        self._driving = self._settled = None
+
+    def __init__(self, name: str, ctx: AgentContext, remap: dict[str, str] | None = None, **params: Any):
+        super().__init__(name, ctx, remap, **params)
+        self._state_key = self.key(self.p["state"])
+
+    def stored_state(self) -> CopsState | None:
+        """The agent's COPS state; None until a behaviour has made it."""
+        return self.get(self._state_key)
+
+    @property
+    def state(self) -> CopsState:
+        st = self.get(self._state_key)
+        if st is None:
+            st = CopsState()
+            self.bb.set(self._state_key, st)
+        return st
+
+    @property
+    def radio(self) -> Any:
+        return self.ctx.robot.radio if self.ctx.robot is not None else self.ctx.services["radio"]
+
+    def greet_home(self, st: "CopsState") -> None:
+        """Greet the leader from the base, with everything the agent holds (what it
+        mapped on its way home included)."""
+        collect_own_map(self.ctx, st.knowledge)
+        self.radio.send(self.p["leader"], KIND, {"type": "hello", "home": True, "payload": st.knowledge.payload()})
+
+    def drive_to(self, there: str, arrive: bool = False) -> Status | None:
+        """Drive towards location ``there`` through the NetworkView: None once there
+        (in its region; with ``arrive``, at the end of its route to the position, or as
+        near the position as the robot can get inside the region), RUNNING on the way,
+        FAILURE when it cannot get there (no route, or blocked). A route that ends short of ``there`` (a voxel map's
+        graph reaches further as the robot walks) is asked for again where it ends."""
+        view, robot = network_view(self.ctx), self.robot
+        inside = view.location() == there
+        on_own_route = self._driving == there and getattr(self, "_command_id", None) == robot.command_id
+        if inside and (not arrive or not (on_own_route and robot.path_status == PathStatus.FOLLOWING)
+                       and (self._settled == there or view.arrived(there))):
+            self._driving = None
+            return None
+        if not on_own_route or robot.path_status in (PathStatus.ARRIVED, PathStatus.IDLE):
+            route = view.route(there)
+            if route is None and inside:  # as near as it gets
+                self._driving, self._settled = None, there
+                return None
+            if route is None:
+                self.feedback_message = f"no route to {there}"
+                return Status.FAILURE
+            self.follow(route)
+            self._driving = there
+        if robot.path_status == PathStatus.BLOCKED:
+            self.feedback_message = f"blocked on the way to {there}"
+            return Status.FAILURE
+        return Status.RUNNING
