@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import difflib
 import os
+import warnings
 from collections.abc import Iterable
 from pathlib import Path
 
@@ -79,3 +80,11 @@ class DelveError(Exception):
     def path(self) -> Path | None:
         """``file`` as a Path, or None."""
         return Path(self.file) if self.file is not None else None
+
+
+class DelveDeprecation(UserWarning):
+    """A file uses a form that still works but will go; the message names the file,
+    the line and what to write instead. Shown every time (each place warns once)."""
+
+
+warnings.simplefilter("always", DelveDeprecation)

@@ -12,7 +12,7 @@ re-exported here for importers of this module.
 """
 from __future__ import annotations
 
-import sys
+import warnings
 from collections.abc import Iterable, Iterator, Mapping
 from typing import Any
 
@@ -21,7 +21,7 @@ from py_trees.behaviour import Behaviour
 from ..skills import all_skills
 from ..skills.base import Skill
 from .builtin_nodes import BUILTINS
-from .errors import DelveError, did_you_mean
+from .errors import DelveDeprecation, DelveError, did_you_mean
 from .node_types import KINDS, RESERVED_KEYS, Build, Builder, NodeType, Site, coerce_param, first_paragraph
 
 __all__ = [
@@ -97,7 +97,7 @@ def _alias_builder(cls: type[Skill], alias: str, name: str, fixed: Mapping[str, 
         if (b.site.file, b.site.line, alias) not in _deprecations_told:
             _deprecations_told.add((b.site.file, b.site.line, alias))
             notice = DelveError(f"type {alias!r} is deprecated: write {instead}", b.site.file, b.site.line)
-            print(f"{notice}", file=sys.stderr)
+            warnings.warn(DelveDeprecation(str(notice)), stacklevel=2)
         return cls(name=b.name, ctx=b.ctx, remap=b.remap, **{**b.params, **fixed})
 
     return build
@@ -114,7 +114,7 @@ def skill_types(skills: Mapping[str, type[Skill]] | None = None) -> list[NodeTyp
                               cls=cls))
         for alias, fixed in sorted(cls.__dict__.get("ALIASES", {}).items()):
             params = {k: v for k, v in cls.PARAMS.items() if k not in fixed}
-            doc = f"Deprecated: write {name} with " + ", ".join(f"{k}: {v}" for k, v in fixed.items()) + "."
+            doc = f"Deprecated: write {name}" + "".join(f", {k}: {v}" for k, v in fixed.items()) + "."
             types.append(NodeType(alias, "skill", _alias_builder(cls, alias, name, fixed), params, doc, "none"))
     return types
 

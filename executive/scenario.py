@@ -14,7 +14,7 @@ from typing import Any
 
 import jsonschema
 
-from .errors import DelveError, did_you_mean
+from .errors import DelveDeprecation, DelveError, did_you_mean
 from .supervisor import Command, load_supervisor
 from .teams import DEFAULT_STRATEGY, TEAM_STRATEGIES, TeamStrategy, implied_strategy
 from .worlds import WorldBackend, backend_for, generator_names
@@ -57,11 +57,6 @@ class Fault:
     robot: str
     kind: str
     duration_s: float = 0.0
-
-
-class DelveDeprecation(UserWarning):
-    """A scenario or tree uses a form that still works but will go: the message says
-    what to write instead."""
 
 
 @dataclass(frozen=True)

@@ -6,7 +6,7 @@ A tree file's top-level mapping is the root node. A node is either a typed node:
     name: Explore then home   # optional, default: the type
     memory: true              # parameters as sibling keys (units in names: timeout_s)
     children:                 # composites and many-child idioms
-      - type: Explore
+      - type: ExploreGBPlanner2
       - type: Timeout         # decorators take `child:` (or `children:` with one node)
         duration_s: 600
         child: {type: Home}

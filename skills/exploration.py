@@ -1,7 +1,7 @@
 """Exploration skills."""
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 from py_trees.common import Status
@@ -26,6 +26,9 @@ class ExploreFrontiers(Skill):
     FAILURE when the robot is not on its own navigation graph.
     """
 
+    #: The YAML name says the planner; ``ExploreFrontiers`` is the name it had before.
+    TYPE_NAME = "ExploreNearestFrontier"
+    ALIASES: ClassVar[dict[str, dict[str, Any]]] = {"ExploreFrontiers": {}}
     PARAMS = {
         "cluster_radius_m": Param(float, 0.8, "frontier blocks (2×2×2 voxels) closer than this join", exclusive_minimum=0),
         "min_cluster_voxels": Param(int, 10, "smaller clusters are ignored", minimum=1),

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import zlib
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 from py_trees.common import Access, Status
@@ -197,6 +197,9 @@ class Explore(Skill):
     without progress (the reason is logged as ``explore_failed``).
     """
 
+    #: The YAML name says the planner; ``Explore`` is the name it had before.
+    TYPE_NAME = "ExploreGBPlanner2"
+    ALIASES: ClassVar[dict[str, dict[str, Any]]] = {"Explore": {}}
     PARAMS = {
         "seed": Param(int, 0, "seeds the planner's random generator (with the agent's name)", minimum=0),
         "endurance_homing": Param(bool, True, "the planner checks at each iteration whether to go home"),

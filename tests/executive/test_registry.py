@@ -40,8 +40,8 @@ def test_default_registry_is_cached():
 
 
 
-def test_a_former_skill_name_builds_the_new_form_and_says_so_once(tmp_path, capsys):
-    from delve.executive.errors import DelveError
+def test_a_former_skill_name_builds_the_new_form_and_says_so_once(tmp_path):
+    from delve.executive.errors import DelveDeprecation, DelveError
     from delve.executive.tree_loader import check_context, load_tree
     from delve.skills.homing import Home
 
@@ -49,13 +49,29 @@ def test_a_former_skill_name_builds_the_new_form_and_says_so_once(tmp_path, caps
     assert alias.kind == "skill" and "path_source" not in alias.params and "Deprecated" in alias.doc
     tree = tmp_path / "old.yaml"
     tree.write_text("type: Sequence\nchildren:\n  - type: ReturnHome\n    max_replans: 2\n")
-    for _ in range(2):
-        root = load_tree(tree, check_context())
-        (node,) = root.children
-        assert type(node) is Home and node.p["path_source"] == "navigator" and node.p["max_replans"] == 2
-    err = capsys.readouterr().err
-    assert err.count("deprecated") == 1
-    assert "old.yaml:3: type 'ReturnHome' is deprecated: write type: Home, path_source: navigator" in err
+    with pytest.warns(DelveDeprecation) as told:
+        for _ in range(2):
+            root = load_tree(tree, check_context())
+            (node,) = root.children
+            assert type(node) is Home and node.p["path_source"] == "navigator" and node.p["max_replans"] == 2
+    notices = [str(w.message) for w in told if w.category is DelveDeprecation]
+    assert len(notices) == 1
+    assert "old.yaml:3: type 'ReturnHome' is deprecated: write type: Home, path_source: navigator" in notices[0]
     tree.write_text("type: ReturnHome\npath_source: gbplanner2\n")
     with pytest.raises(DelveError, match="path_source"):
         load_tree(tree, check_context())
+
+
+@pytest.mark.parametrize("former, now", [("Explore", "ExploreGBPlanner2"),
+                                         ("ExploreFrontiers", "ExploreNearestFrontier")])
+def test_exploration_behaviours_are_named_by_their_planner_and_keep_their_former_names(tmp_path, former, now):
+    from delve.executive.errors import DelveDeprecation
+    from delve.executive.tree_loader import check_context, load_tree
+
+    reg = default_registry()
+    assert reg[now].cls is not None and "Deprecated" in reg[former].doc
+    tree = tmp_path / "old.yaml"
+    tree.write_text(f"type: {former}\n")
+    with pytest.warns(DelveDeprecation, match=f"'{former}' is deprecated: write type: {now}"):
+        node = load_tree(tree, check_context())
+    assert type(node) is reg[now].cls

@@ -102,7 +102,7 @@ def test_backtrack_returns_along_the_traversed_path(tmp_path):
         "children": [
             {"type": "FailureIsSuccess", "name": "Time up is fine",
              "child": {"type": "Timeout", "name": "One minute", "duration_s": 60.0,
-                       "child": {"type": "Explore", "name": "Explore", "max_vertices": 300}}},
+                       "child": {"type": "ExploreGBPlanner2", "name": "Explore", "max_vertices": 300}}},
             {"type": "Backtrack", "name": "Backtrack", "distance_m": None},
         ],
     }

@@ -40,7 +40,7 @@ def test_explore_heads_for_the_frontier_and_writes_the_blackboard(half_mapped):
     grid, a, _ = half_mapped
     robot = FakeRobot(grid, body(a, 3.0))
     ctx = make_ctx(robot)
-    explore = build("type: ExploreFrontiers", ctx)
+    explore = build("type: ExploreNearestFrontier", ctx)
     explore.tick_once()
     assert explore.status == Status.RUNNING
     (path,) = robot.paths
@@ -61,7 +61,7 @@ def test_the_nearest_frontier_first_then_the_next(middle_mapped):
     grid, a, _ = middle_mapped
     robot = FakeRobot(grid, body(a, 30.0))  # 16 m from one frontier, 4 m from the other
     ctx = make_ctx(robot)
-    explore = build("type: ExploreFrontiers", ctx)
+    explore = build("type: ExploreNearestFrontier", ctx)
     explore.tick_once()
     assert bb("frontiers_left") == 2
     assert run(explore, ctx, robot, ticks=300) == Status.SUCCESS
@@ -73,7 +73,7 @@ def test_on_a_map_that_never_changes_every_frontier_is_visited_then_exploration_
     grid, a, _ = middle_mapped
     robot = FakeRobot(grid, body(a, 25.0))
     ctx = make_ctx(robot)
-    explore = build("type: ExploreFrontiers", ctx)
+    explore = build("type: ExploreNearestFrontier", ctx)
     assert run(explore, ctx, robot, ticks=300) == Status.SUCCESS
     assert kinds(ctx) == ["frontier_goal", "frontier_blacklisted"] * 2 + ["exploration_complete"]
     assert {e["reason"] for e in events(ctx, "frontier_blacklisted")} == {"still a frontier after a visit"}
@@ -83,11 +83,11 @@ def test_on_a_map_that_never_changes_every_frontier_is_visited_then_exploration_
     assert min(xs) < a[0] + 20.0 and max(xs) > a[0] + 29.0  # both ends visited
 
 
-@pytest.mark.parametrize("text", ["type: ExploreFrontiers",
-                                  "type: ExploreFrontiers\nmin_cluster_voxels: 100000"])
+@pytest.mark.parametrize("text", ["type: ExploreNearestFrontier",
+                                  "type: ExploreNearestFrontier\nmin_cluster_voxels: 100000"])
 def test_nothing_to_explore_succeeds_at_once(half_mapped, text):
     """A tunnel mapped all along (closed at both ends), or frontiers all too small."""
-    grid, a, _ = syn.straight_tunnel(length_m=24) if text == "type: ExploreFrontiers" else half_mapped
+    grid, a, _ = syn.straight_tunnel(length_m=24) if text == "type: ExploreNearestFrontier" else half_mapped
     robot = FakeRobot(grid, body(a, 3.0))
     ctx = make_ctx(robot)
     explore = build(text, ctx)
@@ -102,7 +102,7 @@ def test_a_frontier_explored_on_the_way_is_left_without_blacklisting(half_mapped
     whole, _, _ = syn.straight_tunnel(length_m=50)  # the same tunnel, mapped to its far end
     robot = FakeRobot(grid, body(a, 3.0))
     ctx = make_ctx(robot)
-    explore = build("type: ExploreFrontiers\ncheck_period_s: 2.0", ctx)
+    explore = build("type: ExploreNearestFrontier\ncheck_period_s: 2.0", ctx)
     goal = None
     statuses = []
     for t in range(6):
@@ -127,7 +127,7 @@ def test_a_blocked_path_blacklists_its_frontier(middle_mapped):
     robot = FakeRobot(grid, body(a, 26.0))  # 8 m from one frontier, 12 m from the other
     robot.block_at, robot.block_radius_m = body(a, 29.0), 1.0  # rock on the way to the nearest
     ctx = make_ctx(robot)
-    explore = build("type: ExploreFrontiers", ctx)
+    explore = build("type: ExploreNearestFrontier", ctx)
     for _ in range(5):
         explore.tick_once()
         robot.step(1.0)
@@ -145,7 +145,7 @@ def test_dwells_at_a_goal_before_judging_it(half_mapped):
     grid, a, _ = half_mapped
     robot = FakeRobot(grid, body(a, 3.0))
     ctx = make_ctx(robot)
-    explore = build("type: ExploreFrontiers\ndwell_s: 5.0", ctx)
+    explore = build("type: ExploreNearestFrontier\ndwell_s: 5.0", ctx)
     arrived_s = judged_s = None
     for _ in range(60):
         explore.tick_once()
@@ -165,7 +165,7 @@ def test_a_robot_off_its_navigation_graph_fails(half_mapped):
     grid, a, _ = half_mapped
     robot = FakeRobot(grid, body(a, 10.0, 4.5))  # inside the rock beside the tunnel
     ctx = make_ctx(robot)
-    explore = build("type: ExploreFrontiers", ctx)
+    explore = build("type: ExploreNearestFrontier", ctx)
     explore.tick_once()
     assert explore.status == Status.FAILURE and robot.paths == []
     assert events(ctx, "explore_failed")[0]["reason"] == "robot is not on its navigation graph"
@@ -175,7 +175,7 @@ def test_interrupted_it_stops_its_own_motion_and_plans_afresh(half_mapped):
     grid, a, _ = half_mapped
     robot = FakeRobot(grid, body(a, 3.0))
     ctx = make_ctx(robot)
-    explore = build("type: ExploreFrontiers", ctx)
+    explore = build("type: ExploreNearestFrontier", ctx)
     explore.tick_once()
     robot.step(3.0)
     explore.stop(Status.INVALID)  # say, the endurance is low

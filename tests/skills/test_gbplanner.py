@@ -92,9 +92,9 @@ def test_the_same_seed_and_agent_give_the_same_plan(half_mapped):
 
 def test_bad_planner_overrides_fail_when_the_tree_is_built():
     with pytest.raises(DelveError, match="unknown GBPlannerConfig parameter"):
-        build_tree({"type": "Explore", "planner": {"num_vertice_max": 10}}, check_context())
+        build_tree({"type": "ExploreGBPlanner2", "planner": {"num_vertice_max": 10}}, check_context())
     with pytest.raises(DelveError, match="max_vertices"):
-        build_tree({"type": "Explore", "max_vertices": 1}, check_context())
+        build_tree({"type": "ExploreGBPlanner2", "max_vertices": 1}, check_context())
 
 
 def test_parse_bbox():

@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 import py_trees
 import pytest
+from delve.executive.errors import DelveDeprecation
 from delve.planners.gbplanner2 import synthetic as syn
 from py_trees.common import Status
 
@@ -226,8 +227,17 @@ def test_return_home_fails_when_home_cannot_be_reached(tunnel):
     assert events(ctx, "homing_failed") and bb("returned_home") is not True
 
 
-def test_the_former_name_return_home_still_works_and_says_what_to_write(u_tunnel, capsys):
+def test_the_former_name_return_home_still_works_and_says_what_to_write(u_tunnel):
     walked = []
+    with pytest.warns(DelveDeprecation) as told:
+        walk_home_twice(u_tunnel, walked)
+    assert len(walked[0]) == len(walked[1]) == 1 and np.array_equal(walked[0][0], walked[1][0])
+    notice = " ".join(str(w.message) for w in told)
+    assert "'ReturnHome' is deprecated" in notice and "path_source: navigator" in notice
+
+
+def walk_home_twice(u_tunnel, walked: list) -> None:
+    """Walk home once as Home with path_source: navigator and once as ReturnHome."""
     for text in (RETURN_HOME, "type: ReturnHome"):
         py_trees.blackboard.Blackboard.clear()
         robot = FakeRobot(u_tunnel, FAR_SIDE, home=HOME)
@@ -236,9 +246,6 @@ def test_the_former_name_return_home_still_works_and_says_what_to_write(u_tunnel
         homing = build(text, ctx, within=TREES / "test_homing_alias")
         assert run(homing, ctx, robot) == Status.SUCCESS and bb("returned_home") is True
         walked.append(robot.paths)
-    assert len(walked[0]) == len(walked[1]) == 1 and np.array_equal(walked[0][0], walked[1][0])
-    err = capsys.readouterr().err
-    assert "'ReturnHome' is deprecated" in err and "path_source: navigator" in err
 
 
 def test_return_home_interrupted_stops_only_its_own_motion(tunnel):

@@ -11,7 +11,7 @@ from py_trees.common import Status
 from .fakes import FakeRobot, bb, body, build, events, make_ctx, run
 
 EXPLORE = """
-type: Explore
+type: ExploreGBPlanner2
 max_vertices: 150
 planner: {num_edges_max: 2500}
 """
