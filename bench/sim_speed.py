@@ -24,7 +24,8 @@ from delve.planners import frontier, navgraph
 from delve.sim import robot as robot_mod
 from delve.sim.voxel_map import VoxelMap
 from delve.sim.world import World
-from delve.skills import cops_voxel, exploration, navigation
+from delve.skills import exploration, navigation
+from delve.skills.cops import voxel_view
 
 SPENT: dict[str, float] = defaultdict(float)
 
@@ -53,7 +54,7 @@ def instrument() -> None:
         timed(mod, "frontier_voxels", "planning")
         timed(mod, "frontier_clusters", "planning")
         timed(mod, "nearest_frontier", "planning")
-    timed(cops_voxel, "extract_topology", "planning")
+    timed(voxel_view, "extract_topology", "planning")
     timed(agent_mod.Agent, "tick_if_due", "ticking (incl. planning)")
     timed(robot_mod.SimRobot, "step", "kinematics")
 

@@ -1,5 +1,5 @@
 """COPS: communication-preserving, information-consistent plans made at the base
-station and executed by every robot's Figure 4 tree (``skills/cops.py``,
+station and executed by every robot's Figure 4 tree (``skills/cops/``,
 ``planners/cops/``).
 
 On any world that gives a mobility-communication network

@@ -17,7 +17,7 @@ from ...sim.robot import SimRobot
 from ...sim.voxel_map import VoxelMap
 from ...sim.world import World
 from ...skills.base import AgentContext
-from ...skills.cops_voxel import VoxelNetworkView
+from ...skills.cops.voxel_view import VoxelNetworkView
 from ...skills.navigation import navigator
 from ..errors import DelveError
 from ..yamlio import YamlDict

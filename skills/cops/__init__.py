@@ -19,7 +19,7 @@ Behaviours, in the paper's words, by module:
 * :mod:`.conditions`: ``Explore?`` (``IsExploring``) and ``FinishedPlan?``.
 
 :mod:`.state` holds the state and the message ids, :mod:`.base` the behaviours'
-common base.
+common base, :mod:`.voxel_view` the network a robot's voxel map reveals.
 """
 from __future__ import annotations
 

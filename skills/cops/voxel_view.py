@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from ..planners.cops.extraction import (
+from ...planners.cops.extraction import (
     DEFAULT_CELL_M,
     DEFAULT_COMM_RANGE_M,
     DEFAULT_MIN_FREE_VOXELS,
@@ -31,12 +31,12 @@ from ..planners.cops.extraction import (
     extract_topology,
     lattice_cells,
 )
-from ..planners.cops.topology import Topology
-from ..planners.navgraph import NavGraph
-from ..planners.occupancy import FREE, Grid
-from .base import AgentContext
-from .navigation import Navigator, Plan
-from .robot import Robot
+from ...planners.cops.topology import Topology
+from ...planners.navgraph import NavGraph
+from ...planners.occupancy import FREE, Grid
+from ..base import AgentContext
+from ..navigation import Navigator, Plan
+from ..robot import Robot
 
 #: Flying robots' standable voxels: the free voxels within this many voxels of a node
 #: of the aerial graph (whose nodes lie on a lattice of every second voxel).

@@ -1,4 +1,4 @@
-"""delve.skills.cops_voxel: the COPS network of a SimRobot's onboard map."""
+"""delve.skills.cops.voxel_view: the COPS network of a SimRobot's onboard map."""
 from __future__ import annotations
 
 import networkx as nx
@@ -10,7 +10,7 @@ from delve.sim.radio import RadioNetwork, RadioSpec
 from delve.sim.robot import SimRobot
 from delve.sim.world import World
 from delve.sim.worldgen_geometry import VoxelCanvas, carve_tunnel, free_space_mesh
-from delve.skills.cops_voxel import MIN_PROGRESS_M, VoxelNetworkView
+from delve.skills.cops.voxel_view import MIN_PROGRESS_M, VoxelNetworkView
 
 V = 0.2
 DT_S = 0.2          # one sim step, one sweep of the sensors
