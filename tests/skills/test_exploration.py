@@ -12,13 +12,6 @@ from py_trees.common import Status
 from .fakes import FakeRobot, bb, body, build, events, make_ctx, run
 
 
-@pytest.fixture(autouse=True)
-def clean_blackboard():
-    py_trees.blackboard.Blackboard.clear()
-    yield
-    py_trees.blackboard.Blackboard.clear()
-
-
 @pytest.fixture(scope="module")
 def half_mapped():
     """A 50 m tunnel mapped for its first 25 m: one frontier, at x = a + 24 m."""

@@ -20,13 +20,6 @@ HOME = np.array([5.0, 4.0, 1.5])
 FAR_SIDE = np.array([5.0, 12.0, 1.5])
 
 
-@pytest.fixture(autouse=True)
-def clean_blackboard():
-    py_trees.blackboard.Blackboard.clear()
-    yield
-    py_trees.blackboard.Blackboard.clear()
-
-
 @pytest.fixture(scope="module")
 def u_tunnel():
     """Two parallel 22 m tunnels 8 m apart, joined at their far ends (3 m wide, floor at

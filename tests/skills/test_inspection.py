@@ -1,5 +1,6 @@
-"""delve.skills.inspection: the Inspect skill and its geometry, on a fake robot that
-walks a synthetic tunnel map with the simulator's pan-tilt-zoom payload."""
+"""delve.skills.inspection and .inspection_steps: the inspection subtree and its
+geometry, on a fake robot that walks a synthetic tunnel map with the simulator's
+pan-tilt-zoom payload."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -7,20 +8,15 @@ from pathlib import Path
 import numpy as np
 import py_trees
 import pytest
-from delve.executive.tree_loader import load_tree
+import yaml
+from delve.executive.tree_loader import build_tree, load_tree
 from delve.planners.gbplanner2 import synthetic as syn
 from delve.planners.occupancy import Grid
 from delve.sim.payload import PanTiltZoomCamera
 from delve.skills.base import Skill
 from delve.planners.visibility import BodyCameras, joint_directions
-from delve.skills.inspection import (
-    SEEN_SERVICE,
-    Inspect,
-    SeenRecord,
-    body_pose,
-    joints_toward,
-    plan_inspection,
-)
+from delve.skills import all_skills
+from delve.skills.inspection import SEEN_SERVICE, SeenRecord, body_pose, joints_toward, plan_inspection
 from delve.skills.robot import PathStatus
 from py_trees.common import Status
 
@@ -39,9 +35,28 @@ def camera_robot(grid: Grid, position, payload: bool = True) -> fakes.FakeRobot:
     return fakes.FakeRobot(grid, position, payload=camera)
 
 
+def inspect(ctx, **params):
+    """The inspection of ``trees/subtrees/inspections.yaml`` without its SuccessIsFailure
+    (SUCCESS when done), each of ``params`` given to the step that declares it."""
+    tree = yaml.safe_load((TREES / "subtrees" / "inspections.yaml").read_text())["child"]
+    skills = all_skills()
+    left = dict(params)
+
+    def place(node):
+        cls = skills.get(node["type"])
+        for key in [k for k in left if cls is not None and k in cls.PARAMS]:
+            node[key] = left.pop(key)
+        for child in node.get("children", []):
+            place(child)
+
+    place(tree)
+    assert not left, f"no step takes {sorted(left)}"
+    return build_tree(tree, ctx)
+
+
 class Walker(Skill):
     """A lower-priority block like Explore: follows a fixed path and, halted, stops the
-    robot whatever it is doing (the behaviour Inspect must survive)."""
+    robot whatever it is doing (the behaviour the inspection must survive)."""
 
     def __init__(self, name, ctx, path, **kw):
         super().__init__(name, ctx, **kw)
@@ -157,7 +172,7 @@ def test_no_request_fails_and_keeps_recording_what_the_body_cameras_see(tunnel):
     grid, start, _ = tunnel
     robot = camera_robot(grid, body(start, 6))
     ctx = make_ctx(robot)
-    node = Inspect("Inspect", ctx)
+    node = inspect(ctx)
     assert step(node, ctx, robot) == Status.FAILURE
     record = ctx.services[SEEN_SERVICE]
     assert record.seen.sum() > 100 and record.updates == 1
@@ -175,7 +190,7 @@ def test_full_scan_pauses_scans_every_point_and_resumes_the_same_path(tunnel):
     for _ in range(5):
         robot.step(0.2)
     ctx = make_ctx(robot)
-    node = Inspect("Inspect", ctx, dwell_s=0.5, **NARROW)
+    node = inspect(ctx, dwell_s=0.5, **NARROW)
     left = robot.remaining_path
     sent = request(ctx)
     assert step(node, ctx, robot) == Status.RUNNING
@@ -221,7 +236,7 @@ def test_point_scan_scans_while_the_robot_walks_on(tunnel):
     grid, start, _ = tunnel
     robot = camera_robot(grid, body(start, 2))
     ctx = make_ctx(robot)
-    node = Inspect("Inspect", ctx, dwell_s=0.3, resume_until_path_end=False)
+    node = inspect(ctx, dwell_s=0.3, resume_until_path_end=False)
     path = straight_path(robot.position, 16.0)
     robot.follow_path(path)
     for _ in range(25):                               # walk 5 m, the body cameras looking about
@@ -251,21 +266,21 @@ def test_inspections_put_the_block_below_on_hold_and_survive_its_stop(tunnel):
     grid, start, _ = tunnel
     robot = camera_robot(grid, body(start, 2))
     ctx = make_ctx(robot)
-    inspect = Inspect("Inspect", ctx, dwell_s=0.3, resume_until_path_end=False)
+    inspection = inspect(ctx, dwell_s=0.3, resume_until_path_end=False)
     walker = Walker("Walk", ctx, straight_path(robot.position, 18.0))
     root = py_trees.composites.Selector("Blocks", memory=False, children=[
-        py_trees.decorators.SuccessIsFailure("Inspections", inspect), walker])
+        py_trees.decorators.SuccessIsFailure("Inspections", inspection), walker])
     for _ in range(20):
         assert step(root, ctx, robot) == Status.RUNNING
     assert walker.status == Status.RUNNING
     left = robot.remaining_path
     request(ctx)
     step(root, ctx, robot)
-    assert inspect.status == Status.RUNNING and walker.status == Status.INVALID
-    step(root, ctx, robot)                            # the walker stopped it; Inspect walks on
+    assert inspection.status == Status.RUNNING and walker.status == Status.INVALID
+    step(root, ctx, robot)                            # the walker stopped it; the inspection walks on
     assert robot.path_status == PathStatus.FOLLOWING
     assert np.allclose(robot.paths[-1][-1], left[-1])
-    while inspect.status == Status.RUNNING:
+    while inspection.status == Status.RUNNING:
         step(root, ctx, robot)
         assert robot.path_status in (PathStatus.FOLLOWING, PathStatus.ARRIVED)
     assert events(ctx, "inspection_done")
@@ -276,7 +291,7 @@ def test_a_point_out_of_reach_fails_when_approaching_is_off(tunnel):
     grid, start, _ = tunnel
     robot = camera_robot(grid, body(start, 2))
     ctx = make_ctx(robot)
-    node = Inspect("Inspect", ctx, approach_point=False)
+    node = inspect(ctx, approach_point=False)
     request(ctx, point=[start[0] + 15.0, start[1], 3.9])
     assert step(node, ctx, robot) == Status.FAILURE
     (failed,) = events(ctx, "inspection_failed")
@@ -290,7 +305,7 @@ def test_a_point_in_reach_is_inspected_around_it(tunnel):
     grid, start, _ = tunnel
     robot = camera_robot(grid, body(start, 4))
     ctx = make_ctx(robot)
-    node = Inspect("Inspect", ctx, dwell_s=0.2)
+    node = inspect(ctx, dwell_s=0.2)
     point = [start[0] + 6.5, start[1], 3.9]            # the roof, 2.5 m ahead
     request(ctx, point=point)
     status = step(node, ctx, robot)
@@ -312,7 +327,7 @@ def test_impossible_requests_fail_with_a_reason(tunnel, point, payload, reason):
     grid, start, _ = tunnel
     robot = camera_robot(grid, body(start, 4), payload=payload)
     ctx = make_ctx(robot)
-    node = Inspect("Inspect", ctx)
+    node = inspect(ctx)
     request(ctx, point=point)
     assert step(node, ctx, robot) == Status.FAILURE
     assert events(ctx, "inspection_failed")[0]["reason"] == reason
@@ -323,7 +338,7 @@ def test_a_newer_request_is_kept_for_the_next_run(tunnel):
     grid, start, _ = tunnel
     robot = camera_robot(grid, body(start, 4))
     ctx = make_ctx(robot)
-    node = Inspect("Inspect", ctx, dwell_s=0.2, **NARROW)
+    node = inspect(ctx, dwell_s=0.2, **NARROW)
     request(ctx)
     step(node, ctx, robot)
     newer = request(ctx, point=[start[0] + 6.5, start[1], 3.9])
@@ -358,7 +373,7 @@ def test_a_point_out_of_reach_is_walked_to_then_the_same_path_resumed(tunnel):
     robot.step(1.0)
     left = robot.remaining_path
     ctx = make_ctx(robot)
-    node = Inspect("Inspect", ctx, dwell_s=0.2)
+    node = inspect(ctx, dwell_s=0.2)
     request(ctx, point=[start[0] + 14.0, start[1], 3.9])             # the roof, 11 m ahead
     assert step(node, ctx, robot) == Status.RUNNING
     (approach,) = events(ctx, "inspection_approach")

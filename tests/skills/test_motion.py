@@ -13,13 +13,6 @@ from py_trees.common import Status
 from .fakes import FakeRobot, events, make_ctx, run
 
 
-@pytest.fixture(autouse=True)
-def clean_blackboard():
-    py_trees.blackboard.Blackboard.clear()
-    yield
-    py_trees.blackboard.Blackboard.clear()
-
-
 @pytest.fixture(scope="module")
 def tunnel():
     """A 30 m tunnel along x, mapped all along; floor at z = 1 m; start and end floor centres."""

@@ -15,13 +15,6 @@ KEYS = ("mode", "time_budget_s", "budget_start_s", "goal", "goal_source", "explo
         "inspection_request", "breadcrumb_request", "last_command")
 
 
-@pytest.fixture(autouse=True)
-def clean_blackboard():
-    py_trees.blackboard.Blackboard.clear()
-    yield
-    py_trees.blackboard.Blackboard.clear()
-
-
 @pytest.fixture(scope="module")
 def tunnel():
     return syn.straight_tunnel(length_m=30)

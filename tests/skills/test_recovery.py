@@ -14,13 +14,6 @@ from py_trees.common import Status
 from .fakes import FakeRobot, bb, body, build, events, make_ctx
 
 
-@pytest.fixture(autouse=True)
-def clean_blackboard():
-    py_trees.blackboard.Blackboard.clear()
-    yield
-    py_trees.blackboard.Blackboard.clear()
-
-
 @pytest.fixture(scope="module")
 def tunnel():
     return syn.straight_tunnel(length_m=30)

@@ -17,13 +17,6 @@ planner: {num_edges_max: 2500}
 """
 
 
-@pytest.fixture(autouse=True)
-def clean_blackboard():
-    py_trees.blackboard.Blackboard.clear()
-    yield
-    py_trees.blackboard.Blackboard.clear()
-
-
 @pytest.fixture(scope="module")
 def half_mapped():
     """A 50 m tunnel along x mapped for its first 25 m."""

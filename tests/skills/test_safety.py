@@ -18,13 +18,6 @@ min_motion_m: 0.3
 """
 
 
-@pytest.fixture(autouse=True)
-def clean_blackboard():
-    py_trees.blackboard.Blackboard.clear()
-    yield
-    py_trees.blackboard.Blackboard.clear()
-
-
 @pytest.fixture(scope="module")
 def tunnel():
     return syn.straight_tunnel(length_m=40)
