@@ -122,8 +122,8 @@ def test_shrinking_local_planner_refills_a_graph_starved_box(monkeypatch):
     p = np.asarray(a, float) + np.array([10.0, 0.0, 0.5])
     # ANYmal C fitted to a 0.4 m radius robot on 0.2 m voxels (as the Explore skill fits it).
     cfg = GBPlannerConfig.preset("legged").with_robot_limits(
-        speed_mps=1.0, body_height_m=0.5, radius_m=0.3, max_inclination_deg=35.0, max_step_m=0.3,
-        endurance_s=3000.0).replace(num_vertices_max=150, num_edges_max=2500)
+        speed_mps=1.0, body_height_m=0.5, radius_m=0.3, max_inclination_deg=35.0,
+        max_step_m=0.3).replace(num_vertices_max=150, num_edges_max=2500)
     huge = LocalBound(p, np.eye(3), np.array([17.5, 17.5, 8.0]))
     monkeypatch.setattr(lp, "adaptive_local_bound", lambda *args, **kwargs: huge)
     starved = lp.LocalPlanner(cfg).plan(grid, p, np.random.default_rng(0))
