@@ -87,8 +87,8 @@ def test_the_aerial_stack_flies_the_cave_and_its_shaft_and_comes_home(aerial):
     g = aerial.world.centreline
     a, b = next((a, b) for a, b, d in g.edges(data=True) if d["kind"] == "shaft")
     bottom, top = sorted(float(g.nodes[n]["pos"][2]) for n in (a, b))
-    idx = np.stack(np.unravel_index(aerial.truth, aerial.world.free.shape), axis=1)
-    upper = aerial.truth[aerial.world.index_to_center(idx)[:, 2] >= (bottom + top) / 2]
+    idx = np.stack(np.unravel_index(aerial.backend.truth, aerial.world.free.shape), axis=1)
+    upper = aerial.backend.truth[aerial.world.index_to_center(idx)[:, 2] >= (bottom + top) / 2]
     seen = robot.onboard_map.occupancy.reshape(-1)[upper] == 0
     assert len(upper) > 1000 and seen.mean() >= 0.6
     assert robot.traversed_path[:, 2].max() > bottom + 0.6 * (top - bottom)

@@ -17,8 +17,8 @@ def upper_region(mission) -> np.ndarray:
     g = mission.world.centreline
     (a, b) = next((a, b) for a, b, d in g.edges(data=True) if d["kind"] == "shaft")
     bottom, top = sorted(float(g.nodes[n]["pos"][2]) for n in (a, b))
-    z = mission.world.index_to_center(np.stack(np.unravel_index(mission.truth, mission.world.free.shape), axis=1))[:, 2]
-    return mission.truth[z >= (bottom + top) / 2]
+    z = mission.world.index_to_center(np.stack(np.unravel_index(mission.backend.truth, mission.world.free.shape), axis=1))[:, 2]
+    return mission.backend.truth[z >= (bottom + top) / 2]
 
 
 def seen(mission, robot: str, voxels: np.ndarray) -> float:
