@@ -2,24 +2,29 @@
 
 A node type has a YAML name, a kind (``composite``, ``decorator``, ``behaviour``,
 ``idiom`` or ``skill``), declared parameters (:class:`~delve.skills.base.Param`, units in
-the names), how many children it takes, and a builder that turns a :class:`Build`
-(checked parameters, built children, the agent context) into a py_trees behaviour.
+the names), how many children it takes, the blackboard keys it reads and writes (a
+skill's ports), and a builder that turns a :class:`Build` (checked parameters, built
+children, the agent context) into a py_trees behaviour.
 :class:`~delve.executive.registry.Registry` holds them by name.
 """
 from __future__ import annotations
 
 import inspect
+import types
+import typing
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any, NoReturn
 
 from py_trees.behaviour import Behaviour
+from py_trees.ports import PortInformation
 
-from ..skills.base import AgentContext, Param, resolve_key
+from ..skills.base import AgentContext, Param, port_key_param, resolve_key
 from .errors import DelveError
 from .yamlio import YamlDict, YamlList, plain
 
-__all__ = ["KINDS", "RESERVED_KEYS", "Build", "Builder", "NodeType", "Site", "coerce_param", "first_paragraph"]
+__all__ = ["KINDS", "RESERVED_KEYS", "Build", "Builder", "NodeType", "Site", "coerce_param", "first_paragraph",
+           "type_names"]
 
 KINDS = ("composite", "decorator", "behaviour", "idiom", "skill")
 
@@ -96,6 +101,8 @@ class NodeType:
     ``arity`` is how many children it takes: ``none`` (a leaf), ``one`` (``child``, or
     ``children`` with one element) or ``many`` (``children``, at least one).
     ``subtrees`` names extra single-node slots (EternalGuard's ``condition``).
+    ``reads`` and ``writes`` are the blackboard keys it reads and writes, by port name
+    (a skill's ``INPUT_PORTS`` and ``OUTPUT_PORTS``; see :meth:`port_key`).
     """
 
     name: str
@@ -106,6 +113,18 @@ class NodeType:
     arity: str = "none"
     subtrees: Mapping[str, str] = field(default_factory=dict)
     cls: type | None = None
+    reads: Mapping[str, PortInformation] = field(default_factory=dict)
+    writes: Mapping[str, PortInformation] = field(default_factory=dict)
+
+    def port_key(self, port: str, info: PortInformation) -> tuple[str | None, str | None]:
+        """The key of a port as a tree names it when no parameter is given (None: no
+        key by default), and the parameter that names it instead (None: the key is the
+        port's name)."""
+        param = port_key_param(info)
+        if param is None:
+            return port, None
+        spec = self.params.get(param)
+        return (spec.default if spec is not None and not spec.required else None), param
 
     def __post_init__(self) -> None:
         if self.kind not in KINDS:
@@ -115,6 +134,18 @@ class NodeType:
         clash = (set(self.params) | set(self.subtrees)) & RESERVED_KEYS
         if clash or set(self.params) & set(self.subtrees):
             raise ValueError(f"node type {self.name!r}: parameter names {sorted(clash)} are reserved")
+
+
+def type_names(data_type: Any) -> list[str]:
+    """A port's ``data_type`` as names: ``float | None`` -> ``["float", "null"]``;
+    ``[]`` for any value."""
+    if data_type is Any or data_type is object:
+        return []
+    if isinstance(data_type, types.UnionType) or typing.get_origin(data_type) is typing.Union:
+        return [n for arg in typing.get_args(data_type) for n in type_names(arg)]
+    if data_type is type(None) or data_type is None:
+        return ["null"]
+    return [getattr(data_type, "__name__", str(data_type))]
 
 
 def first_paragraph(obj: Any) -> str:

@@ -3,7 +3,8 @@
 :func:`default_registry` offers py_trees' composites, decorators, behaviours and idioms
 (:mod:`.builtin_nodes`, with delve's sim-clock ``Timeout``) and every skill of
 :func:`delve.skills.all_skills` under its ``TYPE_NAME`` (or class name); skills build
-with their declared ``PARAMS`` and resolve their own blackboard keys.
+with their declared ``PARAMS`` and register the blackboard keys of their declared
+``INPUT_PORTS`` and ``OUTPUT_PORTS`` themselves.
 
 What a node type is lives in :mod:`.node_types`; the JSON Schema of tree files is
 derived from the registry in :mod:`.tree_schema`, the node reference in
@@ -110,12 +111,14 @@ def skill_types(skills: Mapping[str, type[Skill]] | None = None) -> list[NodeTyp
     skills = all_skills() if skills is None else skills
     types = []
     for name, cls in sorted(skills.items()):
+        ports = {"reads": dict(cls.INPUT_PORTS), "writes": dict(cls.OUTPUT_PORTS)}
         types.append(NodeType(name, "skill", _skill_builder(cls), dict(cls.PARAMS), first_paragraph(cls), "none",
-                              cls=cls))
+                              cls=cls, **ports))
         for alias, fixed in sorted(cls.__dict__.get("ALIASES", {}).items()):
             params = {k: v for k, v in cls.PARAMS.items() if k not in fixed}
             doc = f"Deprecated: write {name}" + "".join(f", {k}: {v}" for k, v in fixed.items()) + "."
-            types.append(NodeType(alias, "skill", _alias_builder(cls, alias, name, fixed), params, doc, "none"))
+            types.append(NodeType(alias, "skill", _alias_builder(cls, alias, name, fixed), params, doc, "none",
+                                  **ports))
     return types
 
 

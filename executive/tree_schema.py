@@ -2,7 +2,9 @@
 
 :func:`tree_schema` gives the schema (draft 2020-12) of a tree file: a node is a typed
 node (one definition per registered type, with its parameters, their units, bounds
-and defaults, and its children) or an include. The package ships it as
+and defaults, and its children) or an include. A skill's definition also lists the
+blackboard keys it reads and writes (its declared ports) under ``x-blackboard``, an
+annotation that validation ignores. The package ships it as
 ``schema/tree.schema.json`` (:data:`SCHEMA_PATH`), written by :mod:`.generate`.
 """
 from __future__ import annotations
@@ -11,8 +13,10 @@ import json
 from pathlib import Path
 from typing import Any
 
+from py_trees.ports import PortInformation
+
 from ..skills.base import Param
-from .node_types import NodeType
+from .node_types import NodeType, type_names
 from .registry import Registry, default_registry
 
 __all__ = ["SCHEMA_FILE_NAME", "SCHEMA_PATH", "param_schema", "schema_text", "tree_schema"]
@@ -24,6 +28,7 @@ SCHEMA_PATH = Path(__file__).resolve().parent / "schema" / SCHEMA_FILE_NAME
 SCHEMA_COMMAND = "make docs"
 
 _JSON_TYPES = {float: "number", int: "integer", bool: "boolean", str: "string", list: "array", dict: "object"}
+_JSON_TYPE_NAMES = {t.__name__: j for t, j in _JSON_TYPES.items()} | {"null": "null"}
 
 
 def _json_serialisable(value: Any) -> bool:
@@ -55,6 +60,27 @@ def param_schema(spec: Param) -> dict[str, Any]:
     return out
 
 
+def _port_schema(t: NodeType, port: str, info: PortInformation, read: bool) -> dict[str, Any]:
+    """One blackboard key of ``t``: its key (when the tree names none other), the
+    parameter that names it, its JSON type (none for a Python object), whether it is
+    required (inputs) and its meaning."""
+    key, param = t.port_key(port, info)
+    out: dict[str, Any] = {"key": key}
+    if param is not None:
+        out["keyParameter"] = param
+    names = type_names(info.data_type)
+    if names and all(n in _JSON_TYPE_NAMES for n in names):
+        json_types = [_JSON_TYPE_NAMES[n] for n in names]
+        out["type"] = json_types[0] if len(json_types) == 1 else json_types
+    if read:
+        out["required"] = info.required
+        if info.has_default and _json_serialisable(info.default_value):
+            out["default"] = info.default_value
+    if info.description:
+        out["description"] = info.description
+    return out
+
+
 def _node_type_schema(t: NodeType) -> dict[str, Any]:
     props: dict[str, Any] = {
         "type": {"const": t.name},
@@ -76,6 +102,11 @@ def _node_type_schema(t: NodeType) -> dict[str, Any]:
     schema["properties"] = props
     schema["required"] = required
     schema["additionalProperties"] = False
+    if t.reads or t.writes:
+        schema["x-blackboard"] = {
+            "reads": [_port_schema(t, p, info, read=True) for p, info in t.reads.items()],
+            "writes": [_port_schema(t, p, info, read=False) for p, info in t.writes.items()],
+        }
     return schema
 
 

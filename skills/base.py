@@ -3,16 +3,22 @@
 A skill is a py_trees behaviour that a YAML tree names by ``type``. It declares its
 parameters in ``PARAMS`` (name -> :class:`Param`, units in the names: ``timeout_s``);
 the executive's loader checks a YAML node against them before it constructs the skill
-with the checked, defaulted values as keyword arguments.
+with the checked, defaulted values as keyword arguments. It declares the blackboard
+keys it reads and writes in ``INPUT_PORTS`` and ``OUTPUT_PORTS`` (name ->
+:class:`py_trees.ports.PortInformation`), from which :class:`Skill` registers each key
+with its access, and from which the node reference and the tree schema list them.
 """
 
 from __future__ import annotations
 
+import copy
 import math
 from dataclasses import dataclass, field
 from typing import Any, Callable, ClassVar, Protocol
 
 import py_trees
+from py_trees.common import Access
+from py_trees.ports import PortInformation
 
 from .robot import Robot
 
@@ -26,13 +32,19 @@ class _Required:
 REQUIRED: Any = _Required()
 
 
+# delve keeps its own Param for a node's YAML parameters: py_trees' PortInformation
+# (type, required, description, default) has no bounds, choices, null-ability or key
+# marking, and the tree loader needs those to check a YAML node (with its file and
+# line) before the behaviour is built, and the schema needs them for its bounds. Ports
+# declare blackboard keys only (Skill.INPUT_PORTS / OUTPUT_PORTS).
 @dataclass(frozen=True)
 class Param:
     """A declared parameter of a behaviour: type, default, bounds and meaning.
 
     ``type`` is one of ``float``, ``int``, ``bool``, ``str``, ``list``, ``dict`` (an
     ``int`` is accepted where a ``float`` is asked). ``key=True`` marks a blackboard
-    key name, which subtree includes remap and agents prefix with their namespace.
+    key name, which subtree includes remap and agents prefix with their namespace
+    (a port declared with :class:`ParamNamedPort` says which key it names).
     """
 
     type: type
@@ -76,6 +88,26 @@ class Param:
         return None
 
 
+@dataclass(frozen=True)
+class ParamNamedPort(PortInformation):
+    """A port whose blackboard key a YAML parameter names: the key is the value of
+    ``key_param`` (a ``Param(str, ..., key=True)`` of the skill), not the port's name;
+    a null value means the skill uses no key there. Remapping and the namespace apply
+    to that value as to any key."""
+
+    key_param: str = ""
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if not self.key_param:
+            raise ValueError("ParamNamedPort needs key_param, the parameter that names the key")
+
+
+def port_key_param(port: PortInformation) -> str | None:
+    """The parameter that names ``port``'s key, or None when the key is the port's name."""
+    return port.key_param if isinstance(port, ParamNamedPort) else None
+
+
 class Clock(Protocol):
     """The simulation clock (or, on a robot, the mission clock)."""
 
@@ -117,11 +149,31 @@ def resolve_key(key: str, namespace: str, remap: dict[str, str] | None = None) -
 class Skill(py_trees.behaviour.Behaviour):
     """Base of delve's behaviours: holds the agent context and checked parameters.
 
-    Subclasses declare ``PARAMS`` and read them from ``self.p`` (a dict). They reach
-    the blackboard through :meth:`key`, which applies remapping and the namespace.
+    Subclasses declare ``PARAMS`` and read them from ``self.p`` (a dict). They declare
+    the blackboard keys they read in ``INPUT_PORTS`` and those they write in
+    ``OUTPUT_PORTS`` (port name -> py_trees' :class:`~py_trees.ports.PortInformation`;
+    the port's name is the key, or, for a :class:`ParamNamedPort`, the value of the
+    parameter that names the key). A key both read and written is declared in both.
+
+    At construction every declared key is resolved (include remaps, then the agent's
+    namespace) and registered on the skill's blackboard client: inputs for READ,
+    outputs for WRITE (which also reads). py_trees' client then refuses a write to an
+    input and any access to an undeclared key. Skills use :meth:`read` and
+    :meth:`write` by port name; ``self.keys`` holds the full keys by port name.
     """
 
     PARAMS: ClassVar[dict[str, Param]] = {}
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {}
+    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {}
+
+    # The declarations are py_trees' own (PortInformation in INPUT_PORTS/OUTPUT_PORTS),
+    # but the keys are not wired through PortsMixin.setup_ports: a port nobody remaps
+    # gets a key of its own node there (namespace/name_uuid/port), while delve's skills
+    # share agent-wide keys (/anymal/goal, written by one node, read by another) named
+    # by YAML parameters and include remaps; get_input() raises on a stored None and
+    # _set_output(None) fails its type check, while delve writes None to mean "cleared"
+    # (goto_failure, the operator's keys); and a key both read and written would have to
+    # be two ports with different names. So Skill registers the keys itself.
 
     def __init__(self, name: str, ctx: AgentContext, remap: dict[str, str] | None = None, **params: Any):
         super().__init__(name)
@@ -130,15 +182,47 @@ class Skill(py_trees.behaviour.Behaviour):
         self.p: dict[str, Any] = {k: spec.default for k, spec in self.PARAMS.items() if not spec.required}
         self.p.update(params)
         self.bb = self.attach_blackboard_client(name=name)
+        self.keys: dict[str, str] = {}
+        for port in {**self.INPUT_PORTS, **self.OUTPUT_PORTS}:
+            key = self.port_key(port)
+            if key is None:
+                continue
+            self.keys[port] = resolve_key(key, self.ctx.namespace, self.remap)
+            access = Access.WRITE if port in self.OUTPUT_PORTS else Access.READ
+            self.bb.register_key(key=self.keys[port], access=access)
+
+    def port_key(self, port: str) -> str | None:
+        """The key of ``port`` as the tree names it (before remap and namespace): the
+        port's name, or the value of the parameter that names it (None: no key)."""
+        info = self.INPUT_PORTS.get(port) or self.OUTPUT_PORTS[port]
+        param = port_key_param(info)
+        return port if param is None else self.p.get(param) or None
+
+    def read(self, port: str, default: Any = None) -> Any:
+        """The value of input ``port``; ``default`` (else the port's declared
+        ``default_value``) when the key was never written or no key is named."""
+        if port not in self.INPUT_PORTS:
+            raise KeyError(f"{type(self).__name__} declares no input port {port!r} (INPUT_PORTS)")
+        if default is None:
+            default = copy.deepcopy(self.INPUT_PORTS[port].default_value)
+        full = self.keys.get(port)
+        return default if full is None else self.get(full, default)
+
+    def write(self, port: str, value: Any) -> None:
+        """Write ``value`` to output ``port``."""
+        if port not in self.OUTPUT_PORTS:
+            raise KeyError(f"{type(self).__name__} declares no output port {port!r} (OUTPUT_PORTS)")
+        self.bb.set(self.keys[port], value)
 
     def key(self, key: str, access: py_trees.common.Access = py_trees.common.Access.WRITE) -> str:
-        """Register ``key`` for this behaviour and return its full name."""
+        """Register ``key`` for this behaviour and return its full name (undeclared: goes
+        once every skill declares its ports)."""
         full = resolve_key(key, self.ctx.namespace, self.remap)
         self.bb.register_key(key=full, access=access)
         return full
 
     def get(self, full_key: str, default: Any = None) -> Any:
-        """Read a registered key, ``default`` when it was never written."""
+        """Read a registered key (full name), ``default`` when it was never written."""
         try:
             return self.bb.get(full_key)
         except KeyError:

@@ -5,6 +5,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 from py_trees.common import Status
+from py_trees.ports import PortInformation
 
 from ..planners.frontier import FrontierCluster, FrontierGoal, frontier_clusters, frontier_voxels, nearest_frontier
 from ..planners.geometry import xyz
@@ -41,11 +42,13 @@ float, 2.0, "how often the target cluster is re-checked", exclusive_minimum=0),
         "dwell_s": Param(float, 1.0, "time to scan at a goal before judging it", minimum=0),
         "explored_fraction": Param(float, 0.8, "a cluster this much explored is left", exclusive_minimum=0, maximum=1),
     }
+    OUTPUT_PORTS = {
+        "frontier_goal": PortInformation(list, description="[x, y, z] of the current goal (m)"),
+        "frontiers_left": PortInformation(int, description="frontier clusters found at the last plan"),
+    }
 
     def __init__(self, name: str, ctx: Any, remap: dict[str, str] | None = None, **params: Any):
         super().__init__(name, ctx, remap, **params)
-        self.k_goal = self.key("frontier_goal")
-        self.k_left = self.key("frontiers_left")
         self.blacklist = np.zeros(0, dtype=np.int64)
         self.goal: FrontierGoal | None = None
         self.arrived_s: float | None = None
@@ -106,7 +109,7 @@ float, 2.0, "how often the target cluster is re-checked", exclusive_minimum=0),
         clusters = frontier_clusters(grid, candidates, cluster_radius_m=self.p["cluster_radius_m"],
                                      min_cluster_voxels=self.p["min_cluster_voxels"],
                                      max_extent_m=self.p["max_cluster_extent_m"])
-        self.bb.set(self.k_left, len(clusters))
+        self.write("frontiers_left", len(clusters))
         # First on the cached navigation graph; if that ends at the robot, on a fresh one.
         for fresh in (False, True):
             plan = nav.from_robot(force=fresh)
@@ -123,7 +126,7 @@ float, 2.0, "how often the target cluster is re-checked", exclusive_minimum=0),
             return Status.SUCCESS
         self.goal, self.checked_s = goal, self.ctx.clock.now_s
         self.follow(plan.path_to(goal.node))
-        self.bb.set(self.k_goal, xyz(plan.graph.positions[goal.node]))
+        self.write("frontier_goal", xyz(plan.graph.positions[goal.node]))
         self.feedback_message = f"to frontier {goal.path_length_m:.1f} m away"
         self.event("frontier_goal", at=xyz(goal.cluster.centroid), path_length_m=round(goal.path_length_m, 2),
                    clusters=len(clusters))

@@ -15,7 +15,8 @@ from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
 import numpy as np
-from py_trees.common import Access, Status
+from py_trees.common import Status
+from py_trees.ports import PortInformation
 
 from ..planners.gbplanner2 import Frontier, GBPlanner, GBPlannerConfig, PlanResult
 from ..planners.gbplanner2.local_planner import ShrinkingLocalPlanner
@@ -227,6 +228,18 @@ class Explore(Skill):
         "reroute_poses": Param(int, 5, "a blocked path is re-planned on the navigation graph to the farthest of "
                                        "this many of its poses (0: off)", minimum=0),
     }
+    INPUT_PORTS = {"exploration_bbox": PortInformation(list | dict, required=False, description="{min: [x, y, z], "
+                                                       "max: [x, y, z]} or [min, max] (m): the local graph stays "
+                                                       "inside it, only frontiers inside it are repositioned to")}
+    OUTPUT_PORTS = {
+        "planner_mode": PortInformation(str, description="explore, reposition, homing or none"),
+        "last_plan_reason": PortInformation(str, description="ok, reposition, homing_due, exploration_complete, "
+                                            "invalid_start, no_path, blocked or error"),
+        "last_plan_detail": PortInformation(str, description="the planner's words"),
+        "exploration_complete": PortInformation(bool, description="True when nothing is left to explore"),
+        "homing_due": PortInformation(bool, description="True when the planner decided that the endurance calls "
+                                      "for homing"),
+    }
 
     def __init__(self, name: str, ctx: Any, remap: dict[str, str] | None = None, **params: Any):
         super().__init__(name, ctx, remap, **params)
@@ -234,12 +247,6 @@ class Explore(Skill):
         self.overrides.update(self.p["planner"])
         # Unknown names and impossible values fail when the tree is built (file and line).
         GBPlannerConfig.preset("legged").replace(**self.overrides)
-        self.k_mode = self.key("planner_mode")
-        self.k_reason = self.key("last_plan_reason")
-        self.k_detail = self.key("last_plan_detail")
-        self.k_complete = self.key("exploration_complete")
-        self.k_homing = self.key("homing_due")
-        self.k_bbox = self.key("exploration_bbox", Access.READ)
         self.following = False
         self.failures = 0
         self.next_plan_s = -float("inf")
@@ -345,7 +352,7 @@ class Explore(Skill):
         r = self.robot
         try:
             svc = gbplanner(self.ctx, r, self.overrides, self.p["seed"])
-            bounds = parse_bbox(self.get(self.k_bbox))
+            bounds = parse_bbox(self.read("exploration_bbox"))
             grid = onboard_grid(self.ctx, r)
             if self.p["seal_map_holes"]:
                 grid = sealed_grid(grid)
@@ -365,7 +372,7 @@ class Explore(Skill):
         self._write(res.mode, code, res.reason)
         if code == "homing_due":
             assert res.homing is not None
-            self.bb.set(self.k_homing, True)
+            self.write("homing_due", True)
             self.feedback_message = "homing due: " + res.reason
             self.event("planner_homing", trigger=True, endurance_s=round(r.endurance_remaining_s, 1),
                        time_home_s=round(res.homing.time_home_s, 1), detail=res.reason)
@@ -383,7 +390,7 @@ class Explore(Skill):
                        **({"detail": res.reason} if res.reason else {}))
             return Status.RUNNING
         if code == "exploration_complete":
-            self.bb.set(self.k_complete, True)
+            self.write("exploration_complete", True)
             self.feedback_message = "exploration complete"
             self.event("exploration_complete", detail=res.reason, iterations=svc.plans)
             return Status.SUCCESS
@@ -417,11 +424,11 @@ class Explore(Skill):
             gp.frontiers.update(hidden)
 
     def _write(self, mode: str, code: str, detail: str) -> None:
-        self.bb.set(self.k_mode, mode)
-        self.bb.set(self.k_reason, code)
-        self.bb.set(self.k_detail, detail)
-        self.bb.set(self.k_complete, code == "exploration_complete")
-        self.bb.set(self.k_homing, code == "homing_due")
+        self.write("planner_mode", mode)
+        self.write("last_plan_reason", code)
+        self.write("last_plan_detail", detail)
+        self.write("exploration_complete", code == "exploration_complete")
+        self.write("homing_due", code == "homing_due")
 
 
 __all__ = ["PLAN_REASONS", "Explore", "PlannerService", "gbplanner", "onboard_grid", "parse_bbox", "plan_reason",

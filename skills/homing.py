@@ -5,6 +5,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 from py_trees.common import Status
+from py_trees.ports import PortInformation
 
 from ..planners.geometry import path_length
 from ..planners.trail import TrailWalk
@@ -34,10 +35,11 @@ class EnduranceLow(Skill):
         "check_period_s": Param(float, 5.0, "how often the way home is re-planned", exclusive_minimum=0),
         "detour_factor": Param(float, 1.5, "straight line to path length when no path is known", minimum=1.0),
     }
+    OUTPUT_PORTS = {"time_to_home_s": PortInformation(float, description="time the way home takes (s), as last "
+                                                                          "planned")}
 
     def __init__(self, name: str, ctx: Any, remap: dict[str, str] | None = None, **params: Any):
         super().__init__(name, ctx, remap, **params)
-        self.k_time = self.key("time_to_home_s")
         self.next_check_s = -float("inf")
         self.time_to_home_s = 0.0
 
@@ -49,7 +51,7 @@ class EnduranceLow(Skill):
             if not np.isfinite(length):
                 length = float(np.linalg.norm(r.position - r.home)) * self.p["detour_factor"]
             self.time_to_home_s = length / r.mobility.speed_mps
-            self.bb.set(self.k_time, round(self.time_to_home_s, 2))
+            self.write("time_to_home_s", round(self.time_to_home_s, 2))
             reserve = r.endurance_remaining_s - (sf * self.time_to_home_s + self.p["margin_s"])
             self.next_check_s = now + max(self.p["check_period_s"], reserve / (1 + sf))
         needed = sf * self.time_to_home_s + self.p["margin_s"]
@@ -97,13 +99,16 @@ class Home(PathMotion):
         "max_replans": Param(int, 5, "re-plans allowed after a blocked path or an arrival short of home", minimum=0),
     }
 
+    OUTPUT_PORTS = {
+        "returned_home": PortInformation(bool, description="True once home"),
+        "planner_mode": PortInformation(str, description="``homing`` once a way home is planned"),
+    }
+
     #: Former YAML names of this behaviour, and the parameters each stands for.
     ALIASES: ClassVar[dict[str, dict[str, Any]]] = {"ReturnHome": {"path_source": "navigator"}}
 
     def __init__(self, name: str, ctx: Any, remap: dict[str, str] | None = None, **params: Any):
         super().__init__(name, ctx, remap, **params)
-        self.k_home = self.key("returned_home")
-        self.k_mode = self.key("planner_mode")
         self.sources, self.straight_home = self.PATH_SOURCES[self.p["path_source"]]
         self.first_source = 0
         self.source = 0
@@ -118,7 +123,7 @@ class Home(PathMotion):
         return bool(np.linalg.norm(r.position - r.home) <= self.p["tolerance_m"])
 
     def arrived(self) -> Status:
-        self.bb.set(self.k_home, True)
+        self.write("returned_home", True)
         self.event("home_reached", endurance_s=round(self.robot.endurance_remaining_s, 1))
         return Status.SUCCESS
 
@@ -154,7 +159,7 @@ class Home(PathMotion):
             self.walk = None
         path = np.vstack([path, r.home])
         self.drive(path)
-        self.bb.set(self.k_mode, "homing")
+        self.write("planner_mode", "homing")
         length = path_length(np.vstack([r.position, path]))
         self.feedback_message = f"home is {length:.0f} m away ({source})"
         self.event("homing", source=source, path_length_m=round(length, 1))

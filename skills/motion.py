@@ -7,12 +7,13 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from py_trees.common import Access, Status
+from py_trees.common import Status
+from py_trees.ports import PortInformation
 
 from ..planners.geometry import path_length, xyz
 from ..planners.occupancy import OCCUPIED
 from ..planners.trail import TrailWalk
-from .base import Param
+from .base import Param, ParamNamedPort
 from .gbplanner import gbplanner, onboard_grid
 from .motion_base import PathMotion, trail_jump_check
 from .navigation import navigator
@@ -59,19 +60,23 @@ class GoTo(PathMotion):
         "tolerance_m": Param(float, 1.0, "distance to the goal that counts as arrived", exclusive_minimum=0),
         "max_replans": Param(int, 3, "re-plans after a blocked path or an arrival short of the goal", minimum=0),
     }
+    INPUT_PORTS = {"goal": ParamNamedPort(list, required=False, description="waypoint [x, y, z] (m), read when "
+                                          "the parameter goal is null", key_param="goal_key")}
+    OUTPUT_PORTS = {
+        "goto_failure": PortInformation(str | None, description="null while going and after arrival, else why it "
+                                        "failed: " + ", ".join(GOTO_FAILURES)),
+        "goto_path_length_m": PortInformation(float, description="length of the path last planned (m)"),
+    }
 
     def __init__(self, name: str, ctx: Any, remap: dict[str, str] | None = None, **params: Any):
         super().__init__(name, ctx, remap, **params)
-        self.k_goal = self.key(self.p["goal_key"], Access.READ)
-        self.k_failure = self.key("goto_failure")
-        self.k_length = self.key("goto_path_length_m")
         self.goal: np.ndarray | None = None
         self.last_end: np.ndarray | None = None
 
     def initialise(self) -> None:
         super().initialise()
         self.goal, self.last_end = None, None
-        self.bb.set(self.k_failure, None)
+        self.write("goto_failure", None)
 
     def update(self) -> Status:
         if self.goal is None:
@@ -94,7 +99,7 @@ class GoTo(PathMotion):
         return self._fail(code, f"{code} after {self.replans - 1} re-plans ({reason or status})")
 
     def _read_goal(self) -> np.ndarray | None:
-        value = self.p["goal"] if self.p["goal"] is not None else self.get(self.k_goal)
+        value = self.p["goal"] if self.p["goal"] is not None else self.read("goal")
         try:
             goal = np.asarray(value, float).reshape(-1)
         except (TypeError, ValueError):
@@ -123,7 +128,7 @@ class GoTo(PathMotion):
             path = np.vstack([path, goal])
         self.drive(path)
         length = path_length(np.vstack([r.position, path]))
-        self.bb.set(self.k_length, round(length, 2))
+        self.write("goto_path_length_m", round(length, 2))
         self.feedback_message = f"goal {length:.0f} m away ({source})"
         self.event("goto", goal=xyz(goal), source=source, path_length_m=round(length, 1))
         return Status.RUNNING
@@ -147,7 +152,7 @@ class GoTo(PathMotion):
         return path, "navigator", "", ""
 
     def _fail(self, code: str, reason: str) -> Status:
-        self.bb.set(self.k_failure, code)
+        self.write("goto_failure", code)
         self.feedback_message = reason
         self.event("goto_failed", goto_failure=code, reason=reason,
                    goal=None if self.goal is None else xyz(self.goal))
@@ -177,13 +182,19 @@ class Backtrack(PathMotion):
         "loop_radius_m": Param(float, 0.75, "the way back skips loops of the trail that come this close",
                                exclusive_minimum=0),
     }
+    INPUT_PORTS = {"until": ParamNamedPort(Any, required=False, description="stop once it holds a true value",
+                                           key_param="until_key")}
+    OUTPUT_PORTS = {"backtracked_m": PortInformation(float, description="distance gone back so far (m)")}
 
     def __init__(self, name: str, ctx: Any, remap: dict[str, str] | None = None, **params: Any):
         super().__init__(name, ctx, remap, **params)
-        self.k_until = self.key(self.p["until_key"], Access.READ) if self.p["until_key"] else None
-        self.k_done = self.key("backtracked_m")
         self.walk: TrailWalk | None = None
         self.start_distance_m = 0.0
+
+    @property
+    def until_key(self) -> str | None:
+        """The full key of ``until_key``; None when it is null."""
+        return self.keys.get("until")
 
     @property
     def max_replans(self) -> int:
@@ -195,13 +206,13 @@ class Backtrack(PathMotion):
         self.walk = None
 
     def reached(self) -> bool:
-        return self.k_until is not None and bool(self.get(self.k_until))
+        return self.until_key is not None and bool(self.read("until"))
 
     def arrived(self) -> Status:
         return self._done(Status.SUCCESS, "condition holds")
 
     def progress(self) -> None:
-        self.bb.set(self.k_done, round(self.robot.distance_m - self.start_distance_m, 2))
+        self.write("backtracked_m", round(self.robot.distance_m - self.start_distance_m, 2))
 
     def path_ended(self, status: PathStatus) -> Status | None:
         if status == PathStatus.BLOCKED:
@@ -209,7 +220,7 @@ class Backtrack(PathMotion):
                 # A loop cut did not work out: the rest of the way exactly as walked.
                 self.event("backtrack_blocked", reason=self.robot.blocked_reason)
             return None
-        if self.k_until is not None:
+        if self.until_key is not None:
             return self._done(Status.FAILURE, "the way back ended and the condition still does not hold")
         return self._done(Status.SUCCESS, "back")
 
@@ -232,11 +243,11 @@ class Backtrack(PathMotion):
             k += 1
         path = path[k:]
         if len(path) == 0:
-            if exact and self.k_until is None:
+            if exact and self.until_key is None:
                 return self._done(Status.SUCCESS, "back")
             return self._done(Status.FAILURE, "no traversed path to go back along")
         if not exact:
-            self.bb.set(self.k_done, 0.0)
+            self.write("backtracked_m", 0.0)
         self.drive(path)
         length = path_length(np.vstack([r.position, path]))
         self.feedback_message = f"backtracking {length:.1f} m"

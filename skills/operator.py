@@ -12,6 +12,7 @@ from __future__ import annotations
 from typing import Any
 
 from py_trees.common import Status
+from py_trees.ports import PortInformation
 
 from .base import Param, Skill
 
@@ -49,19 +50,26 @@ class ProcessOperatorCommands(Skill):
     """
 
     PARAMS = {"initial_mode": Param(str, "idle", "mode before the first command", choices=MODES)}
-
-    def __init__(self, name: str, ctx: Any, remap: dict[str, str] | None = None, **params: Any):
-        super().__init__(name, ctx, remap, **params)
-        keys = ("mode", "time_budget_s", "budget_start_s", "goal", "goal_source", "exploration_bbox",
-                "inspection_request", "breadcrumb_request", "last_command")
-        self.k = {k: self.key(k) for k in keys}
+    #: Set up with ``initial_mode``, ``False`` for ``breadcrumb_request`` and null for the rest.
+    OUTPUT_PORTS = {
+        "mode": PortInformation(str, description="the mode of operation: " + ", ".join(MODES)),
+        "time_budget_s": PortInformation(float | None, description="explore's time budget (s); null: none"),
+        "budget_start_s": PortInformation(float | None, description="sim time the budget started at (s)"),
+        "goal": PortInformation(list | None, description="goto's waypoint [x, y, z] (m)"),
+        "goal_source": PortInformation(str | None, description="who set goal (``supervisor``)"),
+        "exploration_bbox": PortInformation(list | None, description="[min, max] corners of the exploration "
+                                            "bounding box (m)"),
+        "inspection_request": PortInformation(dict | None, description="scan's request: {point, requested_s}"),
+        "breadcrumb_request": PortInformation(bool, description="True when a breadcrumb is to be dropped"),
+        "last_command": PortInformation(str | None, description="the last command applied"),
+    }
 
     def setup(self, **kwargs: Any) -> None:
-        self.bb.set(self.k["mode"], self.p["initial_mode"])
+        self.write("mode", self.p["initial_mode"])
         for k in ("time_budget_s", "budget_start_s", "goal", "goal_source", "exploration_bbox", "inspection_request"):
-            self.bb.set(self.k[k], None)
-        self.bb.set(self.k["breadcrumb_request"], False)
-        self.bb.set(self.k["last_command"], None)
+            self.write(k, None)
+        self.write("breadcrumb_request", False)
+        self.write("last_command", None)
 
     def update(self) -> Status:
         for msg in self.robot.radio.receive():
@@ -70,26 +78,26 @@ class ProcessOperatorCommands(Skill):
         return Status.RUNNING
 
     def _apply(self, command: str, args: dict[str, Any]) -> None:
-        now, set_ = self.ctx.clock.now_s, self.bb.set
+        now, set_ = self.ctx.clock.now_s, self.write
         if command == "explore":
-            set_(self.k["mode"], "explore")
+            set_("mode", "explore")
             budget = args.get("budget_s")
-            set_(self.k["time_budget_s"], budget)
-            set_(self.k["budget_start_s"], now if budget is not None else None)
+            set_("time_budget_s", budget)
+            set_("budget_start_s", now if budget is not None else None)
         elif command == "set_bbox":
-            set_(self.k["exploration_bbox"], [list(args["min"]), list(args["max"])])
+            set_("exploration_bbox", [list(args["min"]), list(args["max"])])
         elif command in ("home", "relocate"):
-            set_(self.k["mode"], command)
+            set_("mode", command)
         elif command == "cancel":
-            set_(self.k["mode"], "idle")
+            set_("mode", "idle")
             self.robot.stop()
         elif command == "goto":
-            set_(self.k["mode"], "goto")
-            set_(self.k["goal"], list(args["goal"]))
-            set_(self.k["goal_source"], "supervisor")
+            set_("mode", "goto")
+            set_("goal", list(args["goal"]))
+            set_("goal_source", "supervisor")
         elif command == "scan":
-            set_(self.k["inspection_request"], {"point": args.get("point"), "requested_s": now})
+            set_("inspection_request", {"point": args.get("point"), "requested_s": now})
         elif command == "drop_breadcrumb":
-            set_(self.k["breadcrumb_request"], True)
-        set_(self.k["last_command"], command)
+            set_("breadcrumb_request", True)
+        set_("last_command", command)
         self.event("operator_command", trigger=True, command=command, **{k: v for k, v in args.items()})

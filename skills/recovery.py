@@ -2,9 +2,8 @@
 supervisor that a goal cannot be reached, pick a frontier to relocate to."""
 from __future__ import annotations
 
-from typing import Any
-
-from py_trees.common import Access, Status
+from py_trees.common import Status
+from py_trees.ports import PortInformation
 
 from .base import Param, Skill
 from .operator import GOAL_UNREACHABLE
@@ -30,13 +29,13 @@ class NotifySupervisor(Skill):
     base station (it waits in the outbox while the link is down). Returns SUCCESS.
     """
 
-    def __init__(self, name: str, ctx: Any, remap: dict[str, str] | None = None, **params: Any):
-        super().__init__(name, ctx, remap, **params)
-        self.k_goal = self.key("goal", Access.READ)
-        self.k_reason = self.key("goto_failure", Access.READ)
+    INPUT_PORTS = {
+        "goal": PortInformation(list, required=False, description="the goal that cannot be reached [x, y, z] (m)"),
+        "goto_failure": PortInformation(str, required=False, description="why (GoTo's failure code)"),
+    }
 
     def update(self) -> Status:
-        goal, reason = self.get(self.k_goal), self.get(self.k_reason)
+        goal, reason = self.read("goal"), self.read("goto_failure")
         self.robot.radio.send(BASE, GOAL_UNREACHABLE, {"goal": goal, "reason": reason})
         self.event("supervisor_notified", trigger=True, goal=goal, reason=reason)
         return Status.SUCCESS

@@ -2,9 +2,8 @@
 breadcrumbs."""
 from __future__ import annotations
 
-from typing import Any
-
-from py_trees.common import Access, Status
+from py_trees.common import Status
+from py_trees.ports import PortInformation
 
 from ..planners.geometry import xyz
 from .base import Param, Skill
@@ -24,10 +23,8 @@ class Relocate(PathMotion):
     """
 
     PARAMS = {"max_replans": Param(int, 3, "re-plans allowed after a blocked path", minimum=0)}
-
-    def __init__(self, name: str, ctx: Any, remap: dict[str, str] | None = None, **params: Any):
-        super().__init__(name, ctx, remap, **params)
-        self.k_target = self.key("relocation_target")
+    OUTPUT_PORTS = {"relocation_target": PortInformation(list | None, description="[x, y, z] of the frontier it "
+                                                         "relocates to (m)")}
 
     def path_ended(self, status: PathStatus) -> Status | None:
         if status == PathStatus.ARRIVED:
@@ -47,7 +44,7 @@ class Relocate(PathMotion):
             return self._fail(res.reason or "no frontier to relocate to")
         self.drive(res.path)
         target = xyz(res.target, 2) if res.target is not None else None
-        self.bb.set(self.k_target, target)
+        self.write("relocation_target", target)
         self.event("relocate", trigger=True, to=target, path_length_m=round(res.length_m, 1))
         return Status.RUNNING
 
@@ -65,14 +62,14 @@ class DeployBreadcrumb(Skill):
     ground to drop it on (the reason in the log; never an exception).
     """
 
-    def __init__(self, name: str, ctx: Any, remap: dict[str, str] | None = None, **params: Any):
-        super().__init__(name, ctx, remap, **params)
-        self.k_request = self.key("breadcrumb_request", Access.WRITE)
+    INPUT_PORTS = {"breadcrumb_request": PortInformation(bool, required=False,
+                                                         description="True when a breadcrumb is to be dropped")}
+    OUTPUT_PORTS = {"breadcrumb_request": PortInformation(bool, description="cleared (False) when it is taken")}
 
     def update(self) -> Status:
-        if not self.get(self.k_request):
+        if not self.read("breadcrumb_request"):
             return Status.FAILURE
-        self.bb.set(self.k_request, False)
+        self.write("breadcrumb_request", False)
         drop = self.robot.deploy_breadcrumb()
         if not drop.ok:
             self.feedback_message = drop.error

@@ -6,7 +6,8 @@ from collections import deque
 from typing import Any
 
 import numpy as np
-from py_trees.common import Access, Status
+from py_trees.common import Status
+from py_trees.ports import PortInformation
 
 from ..planners.geometry import xyz
 from .base import Param, Skill
@@ -61,14 +62,17 @@ class BudgetElapsed(Skill):
     once the budget has elapsed; FAILURE while it has not, or when no budget is set.
     """
 
+    INPUT_PORTS = {
+        "time_budget_s": PortInformation(float, required=False, description="the budget (s); null: none"),
+        "budget_start_s": PortInformation(float, required=False, description="sim time the budget started at (s)"),
+    }
+
     def __init__(self, name: str, ctx: Any, remap: dict[str, str] | None = None, **params: Any):
         super().__init__(name, ctx, remap, **params)
-        self.k_budget = self.key("time_budget_s", Access.READ)
-        self.k_start = self.key("budget_start_s", Access.READ)
         self.fired = False
 
     def update(self) -> Status:
-        budget, start = self.get(self.k_budget), self.get(self.k_start)
+        budget, start = self.read("time_budget_s"), self.read("budget_start_s")
         if budget is None or start is None or self.ctx.clock.now_s - start < budget:
             self.fired = False
             return Status.FAILURE
@@ -89,17 +93,19 @@ class Ping(Skill):
         "period_s": Param(float, 2.0, "time between pings", exclusive_minimum=0),
         "target": Param(str, BASE, "who is pinged"),
     }
+    OUTPUT_PORTS = {
+        "ping_ok": PortInformation(bool, description="the last ping's result (True before the first)"),
+        "failed_pings": PortInformation(int, description="consecutive failed pings"),
+    }
 
     def __init__(self, name: str, ctx: Any, remap: dict[str, str] | None = None, **params: Any):
         super().__init__(name, ctx, remap, **params)
-        self.k_ok = self.key("ping_ok")
-        self.k_failed = self.key("failed_pings")
         self.next_s = 0.0
         self.failed = 0
 
     def setup(self, **kwargs: Any) -> None:
-        self.bb.set(self.k_ok, True)
-        self.bb.set(self.k_failed, 0)
+        self.write("ping_ok", True)
+        self.write("failed_pings", 0)
 
     def update(self) -> Status:
         now = self.ctx.clock.now_s
@@ -107,8 +113,8 @@ class Ping(Skill):
             self.next_s = now + self.p["period_s"]
             ok = bool(self.robot.radio.ping(self.p["target"]))
             self.failed = 0 if ok else self.failed + 1
-            self.bb.set(self.k_ok, ok)
-            self.bb.set(self.k_failed, self.failed)
+            self.write("ping_ok", ok)
+            self.write("failed_pings", self.failed)
         return Status.RUNNING
 
 

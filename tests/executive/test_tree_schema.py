@@ -72,3 +72,17 @@ def test_schema_records_units_and_descriptions():
     assert defs["type.Sequence"]["properties"]["memory"]["default"] is True
     assert set(defs["typed_node"]["properties"]["type"]["enum"]) == set(default_registry().names())
 
+
+
+def test_each_skill_lists_the_blackboard_keys_it_reads_and_writes():
+    defs = tree_schema()["$defs"]
+    goto = defs["type.GoTo"]["x-blackboard"]
+    assert goto["reads"] == [{"key": "goal", "keyParameter": "goal_key", "type": "array", "required": False,
+                              "description": goto["reads"][0]["description"]}]
+    assert [(w["key"], w["type"]) for w in goto["writes"]] == [("goto_failure", ["string", "null"]),
+                                                               ("goto_path_length_m", "number")]
+    for t in default_registry():
+        if t.kind != "skill":
+            continue
+        listed = defs[f"type.{t.name}"].get("x-blackboard", {"reads": [], "writes": []})
+        assert len(listed["reads"]) == len(t.reads) and len(listed["writes"]) == len(t.writes), t.name

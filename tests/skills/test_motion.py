@@ -34,7 +34,7 @@ def test_goto_reaches_a_goal_given_as_a_param(tunnel):
     node = GoTo(name="Go", ctx=ctx, goal=goal.tolist(), tolerance_m=0.5)
     assert run(node, ctx, robot) == Status.SUCCESS
     assert np.linalg.norm(robot.position - goal) <= 0.5
-    assert node.get(node.k_failure) is None
+    assert node.get(node.keys["goto_failure"]) is None
     assert events(ctx, "goto")[0]["source"] == "navigator"
     assert events(ctx, "goto_reached")
 
@@ -57,7 +57,7 @@ def test_goto_fails_with_no_path_for_a_goal_inside_rock(tunnel):
     assert grid.value_at(rock[None])[0] == OCCUPIED
     node = GoTo(name="Go", ctx=ctx, goal=rock.tolist())
     assert run(node, ctx, robot) == Status.FAILURE
-    assert node.get(node.k_failure) == "no_path"
+    assert node.get(node.keys["goto_failure"]) == "no_path"
     assert robot.paths == []
     assert events(ctx, "goto_failed")[0]["goto_failure"] == "no_path"
 
@@ -68,7 +68,7 @@ def test_goto_fails_with_no_path_for_a_goal_out_of_reach(tunnel):
     ctx = make_ctx(robot)
     node = GoTo(name="Go", ctx=ctx, goal=body(a, 10.0, 8.0).tolist(), planner="gbplanner")  # deep in the rock
     assert run(node, ctx, robot) == Status.FAILURE
-    assert node.get(node.k_failure) == "no_path"
+    assert node.get(node.keys["goto_failure"]) == "no_path"
 
 
 def test_goto_without_a_goal_fails(tunnel):
@@ -77,7 +77,7 @@ def test_goto_without_a_goal_fails(tunnel):
     ctx = make_ctx(robot)
     node = GoTo(name="Go", ctx=ctx)
     assert run(node, ctx, robot) == Status.FAILURE
-    assert node.get(node.k_failure) == "no_goal"
+    assert node.get(node.keys["goto_failure"]) == "no_goal"
 
 
 def test_goto_from_a_pose_off_the_map_is_an_invalid_start(tunnel):
@@ -86,7 +86,7 @@ def test_goto_from_a_pose_off_the_map_is_an_invalid_start(tunnel):
     ctx = make_ctx(robot)
     node = GoTo(name="Go", ctx=ctx, goal=body(a, 15.0).tolist())
     assert run(node, ctx, robot) == Status.FAILURE
-    assert node.get(node.k_failure) == "invalid_start"
+    assert node.get(node.keys["goto_failure"]) == "invalid_start"
 
 
 def test_goto_with_the_global_planner(tunnel):
@@ -107,7 +107,7 @@ def test_goto_replans_after_a_blocked_path_and_gives_up(tunnel):
     ctx = make_ctx(robot)
     node = GoTo(name="Go", ctx=ctx, goal=body(a, 15.0).tolist(), max_replans=2)
     assert run(node, ctx, robot) == Status.FAILURE
-    assert node.get(node.k_failure) == "blocked"
+    assert node.get(node.keys["goto_failure"]) == "blocked"
     assert len(robot.paths) == 3
 
 
@@ -126,7 +126,7 @@ def test_backtrack_goes_back_the_distance_along_the_trail(tunnel):
     node = Backtrack(name="Back", ctx=ctx, distance_m=6.0)
     assert run(node, ctx, robot, dt_s=0.5) == Status.SUCCESS
     assert np.allclose(robot.position, body(a, 14.0), atol=1e-6)
-    assert node.get(node.k_done) == pytest.approx(6.0, abs=0.01)
+    assert node.get(node.keys["backtracked_m"]) == pytest.approx(6.0, abs=0.01)
     assert events(ctx, "backtrack")[0]["trigger"] is True
 
 
