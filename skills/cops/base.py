@@ -6,11 +6,17 @@ from typing import Any
 
 from py_trees.common import Status
 
-from ..base import AgentContext, Param, Skill
+from ..base import AgentContext, Param, ParamNamedPort, Skill
 from ..robot import NetworkView, PathStatus
 from .state import KIND, CopsState, collect_own_map
 
 STATE_KEY = Param(str, "cops", "blackboard key of the agent's COPS state", key=True)
+#: The agent's COPS state as the behaviours read it (a fresh one while none is stored)...
+STATE_IN = ParamNamedPort(CopsState, required=False, description="the agent's COPS state (a fresh one while none "
+                          "is stored)", key_param="state")
+#: ... and as those write it that make it when none is stored and change it in place.
+STATE_OUT = ParamNamedPort(CopsState, description="the agent's COPS state, made when none is stored, changed in "
+                           "place", key_param="state")
 
 
 def network_view(ctx: AgentContext) -> NetworkView | None:
@@ -20,10 +26,15 @@ def network_view(ctx: AgentContext) -> NetworkView | None:
 
 
 class CopsSkill(Skill):
-    """Base of the COPS behaviours: the agent's state and radio."""
+    """Base of the COPS behaviours: the agent's state and radio.
+
+    Each reads and writes the state (port ``cops``, its key named by the parameter
+    ``state``); one that only reads it declares no output port."""
 
     ABSTRACT = True
     PARAMS = {"state": STATE_KEY}
+    INPUT_PORTS = {"cops": STATE_IN}
+    OUTPUT_PORTS = {"cops": STATE_OUT}
     #: The location :meth:`drive_to` last sent the robot to, and the last one where
     #: it found the robot as near the position as it can get.
     _driving: str | None = None
@@ -33,20 +44,19 @@ class CopsSkill(Skill):
         """Forget earlier drives (when the behaviour starts afresh)."""
         self._driving = self._settled = None
 
-    def __init__(self, name: str, ctx: AgentContext, remap: dict[str, str] | None = None, **params: Any):
-        super().__init__(name, ctx, remap, **params)
-        self._state_key = self.key(self.p["state"])
-
     def stored_state(self) -> CopsState | None:
         """The agent's COPS state; None until a behaviour has made it."""
-        return self.get(self._state_key)
+        return self.read("cops")
 
     @property
     def state(self) -> CopsState:
-        st = self.get(self._state_key)
+        """The agent's COPS state; while none is stored, a fresh one, which a behaviour
+        that writes the state stores (one that only reads it does not)."""
+        st = self.read("cops")
         if st is None:
             st = CopsState()
-            self.bb.set(self._state_key, st)
+            if "cops" in self.OUTPUT_PORTS:
+                self.write("cops", st)
         return st
 
     @property

@@ -9,6 +9,7 @@ from .base import CopsSkill
 class _PartCheck(CopsSkill):
     ABSTRACT = True
     PART = ""
+    OUTPUT_PORTS = {}  # reads the state only
 
     def update(self) -> Status:
         return Status.SUCCESS if self.state.part == self.PART else Status.FAILURE

@@ -61,6 +61,7 @@ class _PlanTimer(CopsSkill):
     """A sim-clock timer whose duration the plan sets when it is entered."""
 
     ABSTRACT = True
+    OUTPUT_PORTS = {}  # reads the state only
 
     @abstractmethod
     def duration_s(self, st: CopsState) -> float:
