@@ -214,13 +214,6 @@ class Skill(py_trees.behaviour.Behaviour):
             raise KeyError(f"{type(self).__name__} declares no output port {port!r} (OUTPUT_PORTS)")
         self.bb.set(self.keys[port], value)
 
-    def key(self, key: str, access: py_trees.common.Access = py_trees.common.Access.WRITE) -> str:
-        """Register ``key`` for this behaviour and return its full name (undeclared: goes
-        once every skill declares its ports)."""
-        full = resolve_key(key, self.ctx.namespace, self.remap)
-        self.bb.register_key(key=full, access=access)
-        return full
-
     def get(self, full_key: str, default: Any = None) -> Any:
         """Read a registered key (full name), ``default`` when it was never written."""
         try:

@@ -28,11 +28,11 @@ from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
 import numpy as np
-from py_trees.common import Access, Status
+from py_trees.common import Status
 
 from ..planners.geometry import path_length, xyz
 from ..planners.visibility import BodyCameras, line_of_sight
-from .base import AgentContext, Param, Skill
+from .base import AgentContext, Param, ParamNamedPort, Skill
 from .inspection import (
     ScanPoint,
     body_pose,
@@ -47,6 +47,10 @@ from .robot import PathStatus
 
 #: ``ctx.services`` key of the agent's :class:`InspectionState`.
 STATE_SERVICE = "inspection"
+
+#: The request (``{"point": [x, y, z] or null, "requested_s": t}``), as the steps read it.
+REQUEST_IN = ParamNamedPort(dict, required=False, description="the inspection request: {point: [x, y, z] or null, "
+                            "requested_s}; null or none: no request", key_param="request_key")
 
 
 @dataclass
@@ -219,13 +223,10 @@ class TakeInspectionRequest(InspectionStep):
         "point_radius_m": Param(float, 1.0, "area around a requested point that a point request inspects",
                                 exclusive_minimum=0),
     }
-
-    def __init__(self, name: str, ctx: AgentContext, remap: dict[str, str] | None = None, **params: Any):
-        super().__init__(name, ctx, remap, **params)
-        self.k_request = self.key(self.p["request_key"], Access.READ)
+    INPUT_PORTS = {"inspection_request": REQUEST_IN}
 
     def update(self) -> Status:
-        request = self.get(self.k_request)
+        request = self.read("inspection_request")
         if not request:
             self.feedback_message = "no inspection request"
             return Status.FAILURE
@@ -568,18 +569,20 @@ class _Report(InspectionStep):
         "request_key": Param(str, "inspection_request", "blackboard key of the request (cleared)", key=True),
         "result_key": Param(str, "inspection_result", "blackboard key the result is written to", key=True),
     }
-
-    def __init__(self, name: str, ctx: AgentContext, remap: dict[str, str] | None = None, **params: Any):
-        super().__init__(name, ctx, remap, **params)
-        self.k_request = self.key(self.p["request_key"])
-        self.k_result = self.key(self.p["result_key"])
+    INPUT_PORTS = {"inspection_request": REQUEST_IN}
+    OUTPUT_PORTS = {
+        "inspection_request": ParamNamedPort(dict | None, description="cleared (null) once answered, unless a newer "
+                                             "request has replaced it", key_param="request_key"),
+        "inspection_result": ParamNamedPort(dict, description="the result: ok, and what was done or why it failed",
+                                            key_param="result_key"),
+    }
 
     def finish(self, job: InspectionJob, result: dict[str, Any]) -> None:
         """Write ``result``; clear the request this job answered (a newer one stays for
         the next run); the job is over."""
-        self.bb.set(self.k_result, result)
-        if self.get(self.k_request) == job.request:
-            self.bb.set(self.k_request, None)
+        self.write("inspection_result", result)
+        if self.read("inspection_request") == job.request:
+            self.write("inspection_request", None)
         self.state.job = None
 
 

@@ -11,7 +11,7 @@ from delve.executive.builtin_nodes import BUILTINS
 from delve.executive.errors import DelveError
 from delve.executive.registry import Registry, skill_types
 from delve.executive.tree_loader import build_tree, check_tree, compose_remap, load_tree
-from delve.skills.base import REQUIRED, AgentContext, Param, Skill
+from delve.skills.base import REQUIRED, AgentContext, Param, ParamNamedPort, Skill
 from py_trees.common import Status
 
 DATA = Path(__file__).resolve().parent.parent / "data"
@@ -199,15 +199,15 @@ class Fragile(Skill):
         "range_m": Param(float, REQUIRED, doc="range, in metres", minimum=0.0),
         "target": Param(str, "target", doc="blackboard key", key=True),
     }
+    OUTPUT_PORTS = {"target": ParamNamedPort(float, description="the range", key_param="target")}
 
     def __init__(self, name, ctx, remap=None, **params):
         super().__init__(name, ctx, remap, **params)
         if self.p["range_m"] > 100:
             raise ValueError("range_m beyond the sensor's 100 m")
-        self.target_key = self.key(self.p["target"])
 
     def update(self):
-        self.bb.set(self.target_key, self.p["range_m"])
+        self.write("target", self.p["range_m"])
         return Status.SUCCESS
 
 
