@@ -13,10 +13,12 @@ from __future__ import annotations
 
 import copy
 import math
+import re
 from dataclasses import dataclass, field
 from typing import Any, Callable, ClassVar, Protocol
 
 import py_trees
+import yaml
 from py_trees.common import Access
 from py_trees.ports import PortInformation
 
@@ -30,6 +32,60 @@ class _Required:
 
 #: Default of a parameter that a YAML node must give.
 REQUIRED: Any = _Required()
+
+
+#: An error message quotes at most this many characters of a user's value.
+SHOWN_CHARS = 40
+_NUMBER_LIKE = re.compile(r"[-+]?(?:[0-9][0-9_]*)?(?:\.[0-9_]*)?(?:[eE][-+]?[0-9]+)?")
+
+
+def short_repr(value: Any, limit: int = SHOWN_CHARS) -> str:
+    """``repr(value)`` cut to about ``limit`` characters (``...`` marks the cut), so
+    that an error message never quotes more of a file than the offending value's start."""
+    if isinstance(value, int) and not isinstance(value, bool) and value.bit_length() > 3 * limit:
+        return f"<an integer of {len(str(abs(value)))} digits>" if value.bit_length() < 12000 else "<a huge integer>"
+    text = repr(value)
+    if len(text) <= limit:
+        return text
+    end = text[0] if isinstance(value, str) and text[0] in "'\"" else ""
+    return text[:limit] + "..." + end
+
+
+def yaml_number_hint(value: Any, integer: bool = False) -> str:
+    """For a string that reads as a number, what to write instead: YAML 1.1 reads
+    ``1e3`` as a string (its floats need a dot and a signed exponent: ``1.0e+3``), and
+    a quoted number is a string; '' for any other value."""
+    if not isinstance(value, str) or not _NUMBER_LIKE.fullmatch(value.strip()) or not any(c.isdigit() for c in value):
+        return ""
+    text = value.strip()
+    try:
+        number = float(text)
+    except ValueError:
+        return ""
+    if not math.isfinite(number):
+        return ""
+    if isinstance(yaml.safe_load(text), (int, float)):
+        return " (a number in quotes is a string: write it without quotes)"
+    forms = []
+    if number.is_integer() and abs(number) < 1e15:
+        forms.append(str(int(number)))
+    elif integer:
+        return ""
+    elif 1e-4 <= abs(number) < 1e15:
+        forms.append(repr(number))
+    if not integer:
+        digits = next(p for p in range(17) if float(f"{number:.{p}e}") == number or p == 16)
+        mantissa, exponent = f"{number:.{max(digits, 1)}e}".split("e")
+        forms.append(f"{mantissa}e{'+' if int(exponent) >= 0 else '-'}{abs(int(exponent))}")
+    return f" (YAML reads {short_repr(text)[1:-1]} as a string: write {' or '.join(forms)})"
+
+
+def _fits_float(value: int) -> bool:
+    try:
+        float(value)
+    except OverflowError:
+        return False
+    return True
 
 
 # delve keeps its own Param for a node's YAML parameters: py_trees' PortInformation
@@ -65,26 +121,29 @@ class Param:
         """Return why ``value`` is not acceptable, or None when it is."""
         if value is None:
             return None if self.nullable else "must not be null"
+        shown = f"{type(value).__name__} {short_repr(value)}"
         if self.type is float:
             if isinstance(value, bool) or not isinstance(value, (int, float)):
-                return f"must be a number, not {type(value).__name__} {value!r}"
+                return f"must be a number, not {shown}{yaml_number_hint(value)}"
+            if isinstance(value, int) and not _fits_float(value):
+                return f"must be a number within +-1.8e308, not {shown}"
             if math.isnan(value):
                 return "must be a number, not NaN"
             if math.isinf(value) and self.maximum is not None:
                 return "must be finite"
         elif self.type is int:
             if isinstance(value, bool) or not isinstance(value, int):
-                return f"must be an integer, not {type(value).__name__} {value!r}"
+                return f"must be an integer, not {shown}{yaml_number_hint(value, integer=True)}"
         elif not isinstance(value, self.type) or (self.type is not bool and isinstance(value, bool)):
-            return f"must be of type {self.type.__name__}, not {type(value).__name__} {value!r}"
+            return f"must be of type {self.type.__name__}, not {shown}"
         if self.minimum is not None and value < self.minimum:
-            return f"must be >= {self.minimum}, got {value}"
+            return f"must be >= {self.minimum}, got {short_repr(value)}"
         if self.exclusive_minimum is not None and value <= self.exclusive_minimum:
-            return f"must be > {self.exclusive_minimum}, got {value}"
+            return f"must be > {self.exclusive_minimum}, got {short_repr(value)}"
         if self.maximum is not None and value > self.maximum:
-            return f"must be <= {self.maximum}, got {value}"
+            return f"must be <= {self.maximum}, got {short_repr(value)}"
         if self.choices is not None and value not in self.choices:
-            return f"must be one of {', '.join(map(repr, self.choices))}, got {value!r}"
+            return f"must be one of {', '.join(map(repr, self.choices))}, got {short_repr(value)}"
         return None
 
 
