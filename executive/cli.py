@@ -5,8 +5,10 @@
     delve render TREE --format svg|dot|png|txt [--out PATH]
     delve demo
 
-Exit status: 0 when the mission succeeds (every robot's tree ends in SUCCESS), 1
-when it fails, 2 for bad input (one line naming file and line, no traceback).
+Exit status: 0 when the mission succeeds (every robot's tree ends in SUCCESS, every
+robot left its start and the team explored something: see executive/outcome.py), 1
+when it fails (each reason printed as a ``why:`` line), 2 for bad input (one line
+naming file and line, no traceback).
 """
 from __future__ import annotations
 
@@ -106,8 +108,12 @@ def run(path: Path, out: Path | None, seed: int | None, duration_s: float | None
     print(f"{scenario.name}: {'succeeded' if rep['succeeded'] else 'FAILED'} after {rep['sim_time_s']:.0f} s sim "
           f"({rep['wall_time_s']:.1f} s wall), coverage {rep['coverage_fraction']:.1%}, "
           f"at base {rep['base_coverage_fraction']:.1%}")
+    for reason in rep["outcome"]["reasons"]:
+        print(f"  why: {reason}")
+    lost = rep["outcome"]["lost"]
     for r in rep["robots"]:
-        print(f"  {r['name']} ({r['platform']}): {r['final_status']}, {r['distance_m']:.0f} m, "
+        state = f"lost ({lost[r['name']]})" if r["name"] in lost else r["final_status"]
+        print(f"  {r['name']} ({r['platform']}): {state}, {r['distance_m']:.0f} m, "
               f"home={'yes' if r['returned_home'] else 'no'}, {r['endurance_left_s']:.0f} s endurance left")
     print(f"outputs in {out}/")
     return 0 if rep["succeeded"] else 1

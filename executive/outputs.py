@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import json
+import math
 from collections import Counter
 from pathlib import Path
 from typing import Any
@@ -34,7 +35,7 @@ def report(mission: Mission, wall_time_s: float) -> dict[str, Any]:
             "name": name,
             "platform": robot.platform,
             "distance_m": round(robot.distance_m, 2),
-            "returned_home": bool(np.linalg.norm(robot.position - robot.home) <= home_tol),
+            "returned_home": bool(np.linalg.norm(robot.true_position - robot.home) <= home_tol),
             "endurance_left_s": round(robot.endurance_remaining_s, 1),
             "final_status": mission.agents[name].root.status.value,
             "coverage_fraction": last.robots[name],
@@ -42,12 +43,14 @@ def report(mission: Mission, wall_time_s: float) -> dict[str, Any]:
             "messages_sent": robot.radio.sent,
             "messages_undelivered": robot.radio.pending,
             **mission.backend.robot_figures(name, mission.lost),
+            **mission.team.robot_figures(mission, name),
         })
     sim_time = mission.finished_s or mission.clock.now_s
     return {
         "scenario": mission.scenario.name,
         "seed": mission.seed,
         "succeeded": mission.succeeded,
+        "outcome": mission.outcome.to_dict(),
         "sim_time_s": round(sim_time, 3),
         "wall_time_s": round(wall_time_s, 3),
         "real_time_factor": round(sim_time / wall_time_s, 1) if wall_time_s > 0 else None,
@@ -60,6 +63,22 @@ def report(mission: Mission, wall_time_s: float) -> dict[str, Any]:
     }
 
 
+def finite(value: Any) -> Any:
+    """``value`` with every NaN or infinite number replaced by None (strict JSON has
+    neither), and numpy scalars and arrays made plain."""
+    if isinstance(value, dict):
+        return {k: finite(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [finite(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return finite(value.tolist())
+    if isinstance(value, np.generic):
+        value = value.item()
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value
+
+
 def strip_wall_clock(rep: dict[str, Any]) -> dict[str, Any]:
     """The report without its wall-clock fields, for comparing runs."""
     dropped = WALL_CLOCK_FIELDS + wall_clock_fields()
@@ -69,8 +88,8 @@ def strip_wall_clock(rep: dict[str, Any]) -> dict[str, Any]:
 def write_outputs(mission: Mission, out: Path, wall_time_s: float) -> dict[str, Any]:
     """Write every output of the run into ``out`` and return the report."""
     out.mkdir(parents=True, exist_ok=True)
-    rep = report(mission, wall_time_s)
-    (out / "report.json").write_text(json.dumps(rep, indent=2, sort_keys=False) + "\n")
+    rep = finite(report(mission, wall_time_s))
+    (out / "report.json").write_text(json.dumps(rep, indent=2, sort_keys=False, allow_nan=False) + "\n")
     with open(out / "log.jsonl", "w") as f:
         for e in mission.state.events:
             f.write(json.dumps(e, sort_keys=False) + "\n")

@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 from collections import deque
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Any, Callable
 
 import numpy as np
@@ -20,6 +21,8 @@ from ..sim.clock import SimClock
 from ..skills.base import AgentContext
 from ..skills.operator import COMMAND
 from .agent import Agent
+from .faults.schedule import FaultSchedule
+from .outcome import Outcome, mission_outcome
 from .scenario import Scenario
 from .tree_loader import load_tree
 from .worlds import BASE, WorldBackend
@@ -66,9 +69,12 @@ class Mission:
         self.team = scenario.team_strategy()
         self.agents: dict[str, Agent] = {}
         self._commands = deque(scenario.supervisor)
-        self._faults = deque(scenario.faults)
-        self.lost: set[str] = set()
+        self.faults = FaultSchedule(scenario.faults)
+        #: Robots that died (a ``lost`` fault, a flat battery) and why.
+        self.lost: dict[str, str] = {}
         self.finished_s: float | None = None
+        #: Whether the run stopped at ``duration_s`` before the team strategy's end (set by :meth:`run`).
+        self.timed_out: bool | None = None
         self._add_agents()
         self.team.start(self)
 
@@ -122,7 +128,7 @@ class Mission:
     # ---- running ----------------------------------------------------------------
     @property
     def robot_agents(self) -> list[Agent]:
-        """The agents of the robots that were not lost (a ``lost`` fault)."""
+        """The agents of the robots that were not lost (a ``lost`` fault, a flat battery)."""
         return [a for n, a in self.agents.items() if n != BASE and n not in self.lost]
 
     def run(self, progress: Callable[["Mission"], None] | None = None, progress_period_s: float = 10.0) -> None:
@@ -136,6 +142,8 @@ class Mission:
             self.backend.sense(now)
             self.radio.update()
             for agent in self.agents.values():
+                if agent.name in self.lost:
+                    continue
                 if agent.tick_if_due(now) and agent.finished and agent.name in self.robots:
                     self.robots[agent.name].park()
 
@@ -147,12 +155,14 @@ class Mission:
                 next_progress = now + progress_period_s
             if self.team.done(self) or now >= self.duration_s:
                 break
-            for robot in self.robots.values():
+            for name, robot in self.robots.items():
                 robot.step(self.clock.dt_s)
+                if not robot.alive and name not in self.lost:
+                    self.lose(name, robot.blocked_reason or "endurance exhausted")
             self.clock.step()
         self.finished_s = self.clock.now_s
-        timed_out = not self.team.done(self)
-        self.log("mission_end", timed_out=timed_out)
+        self.timed_out = not self.team.done(self)
+        self.log("mission_end", timed_out=self.timed_out)
         for agent in self.robot_agents:
             if not agent.finished:
                 agent.stop()
@@ -162,23 +172,43 @@ class Mission:
             progress(self)
 
     def _supervise(self, now: float) -> None:
-        """Send the supervisor's commands that are due, and inject due faults."""
+        """Send the supervisor's commands that are due; start, step and end faults."""
         while self._commands and self._commands[0].at_s <= now + 1e-9:
             c = self._commands.popleft()
             self.radio.endpoints[BASE].send(c.robot, COMMAND, {"command": c.command, "args": c.args})
             self.log("supervisor_command", robot=c.robot, command=c.command, **c.args)
-        while self._faults and self._faults[0].at_s <= now + 1e-9:
-            f = self._faults.popleft()
-            robot = self.robots[f.robot]
-            if f.kind == "stuck":
-                robot.jam(f.duration_s)
-            elif f.kind == "lost":
-                robot.kill()
-                self.agents[f.robot].stop()
-                self.lost.add(f.robot)
-            else:
-                robot.inject_map_artifact()
-            self.log("fault", robot=f.robot, kind=f.kind, duration_s=f.duration_s)
+        self.faults.update(self, now)
+
+    # ---- what faults do to agents -----------------------------------------------------
+    def lose(self, name: str, reason: str) -> None:
+        """Robot ``name`` dies: it stops, its radio falls silent, its tree stops and no
+        longer ticks; a ``robot_lost`` event gives ``reason``."""
+        if name in self.lost:
+            return
+        self.robots[name].kill()
+        self.agents[name].stop()
+        self.lost[name] = reason
+        self.log("robot_lost", robot=name, reason=reason)
+
+    def restart_agent(self, name: str, resume_s: float) -> int:
+        """Restart agent ``name``'s executive, as after a crash: its tree stops, its
+        blackboard is cleared, the messages in its radio's inbox and outbox are lost,
+        and a tree built afresh from its file ticks from ``resume_s`` on. Its services
+        (the base map, the team's configuration) outlive the restart; the team
+        strategy is told (:meth:`TeamStrategy.restarted`). Returns the messages lost."""
+        old = self.agents[name]
+        old.stop()
+        ctx = self._context(name, old.ctx.robot)
+        ctx.services.update(old.ctx.services)
+        radio = self.radio.endpoints[name]
+        lost = len(radio.inbox) + len(radio.outbox)
+        radio.inbox.clear()
+        radio.outbox.clear()
+        tree = self.scenario.base_tree if name == BASE else next(r.tree for r in self.scenario.robots if r.name == name)
+        self.agents[name] = Agent(name, load_tree(tree, ctx), old.period_s, ctx, on_change=self._status_changed,
+                                  next_tick_s=resume_s)
+        self.team.restarted(self, name)
+        return lost
 
     def _flush(self) -> None:
         end = self.clock.now_s + FLUSH_S
@@ -200,7 +230,13 @@ class Mission:
         ))
 
     # ---- results ----------------------------------------------------------------
+    @cached_property
+    def outcome(self) -> Outcome:
+        """Whether the mission succeeded and why not (asked once it is over): its team
+        strategy's judgement and the mission-level checks (:mod:`.outcome`)."""
+        return mission_outcome(self)
+
     @property
     def succeeded(self) -> bool:
-        """Whether the mission succeeded, as its team strategy judges."""
-        return self.team.succeeded(self)
+        """Whether the mission succeeded (:attr:`outcome`)."""
+        return self.outcome.succeeded

@@ -15,6 +15,8 @@ from typing import Any
 import jsonschema
 
 from .errors import DelveDeprecation, DelveError, did_you_mean
+from .faults import Fault, FaultContext
+from .faults.loader import load_faults
 from .supervisor import Command, load_supervisor
 from .teams import DEFAULT_STRATEGY, TEAM_STRATEGIES, TeamStrategy, implied_strategy
 from .worlds import WorldBackend, backend_for, generator_names
@@ -44,19 +46,6 @@ class RobotSpec:
     breadcrumbs: int = 0
     line: int | None = None
     start_line: int | None = None
-
-
-@dataclass(frozen=True)
-class Fault:
-    """A fault injected at ``at_s``: ``stuck`` (the robot cannot move for
-    ``duration_s``), ``map_artifact`` (rock appears in its onboard map around it,
-    as odometry drift leaves in a real map) or ``lost`` (the robot dies: it stops
-    and its radio falls silent for good)."""
-
-    at_s: float
-    robot: str
-    kind: str
-    duration_s: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -215,6 +204,7 @@ def load_scenario(path: str | Path) -> Scenario:
     from .tree_loader import check_tree
 
     robots, names, tree_types = [], set(), set()  # names: the robots seen so far
+    robot_types: dict[str, set[type]] = {}
     for i, r in enumerate(doc["robots"]):
         line = doc["robots"].item_line(i)
         if r["name"] in names or r["name"] == "base":
@@ -224,7 +214,8 @@ def load_scenario(path: str | Path) -> Scenario:
         tree = (path.parent / r["tree"]).resolve()
         if not tree.exists():
             raise DelveError(f"robot {r['name']!r}: tree file not found: {r['tree']}", path, r.key_line("tree"))
-        tree_types |= check_tree(tree)
+        robot_types[r["name"]] = check_tree(tree)
+        tree_types |= robot_types[r["name"]]
         extra = {k: float(r[k]) for k in ("speed_mps", "max_inclination_deg", "max_step_m") if k in r}
         robots.append(RobotSpec(name=r["name"], platform=r["platform"], tree=tree, start=r.get("start"),
                                 endurance_s=r.get("endurance_s"), tick_hz=float(r.get("tick_hz", 5.0)),
@@ -239,14 +230,8 @@ def load_scenario(path: str | Path) -> Scenario:
             raise DelveError(f"base station tree file not found: {base['tree']}", path, base.key_line("tree"))
         tree_types |= check_tree(base_tree)
     supervisor = load_supervisor(doc.get("supervisor"), path, {r.name: r.breadcrumbs for r in robots})
-    faults = []
-    for i, f in enumerate(doc.get("faults", [])):
-        if f["robot"] not in names:
-            raise DelveError(f"fault for unknown robot {f['robot']!r}{did_you_mean(f['robot'], names)}", path,
-                             doc["faults"].item_line(i))
-        if f["kind"] == "stuck" and "duration_s" not in f:
-            raise DelveError("a 'stuck' fault needs duration_s", path, doc["faults"].item_line(i))
-        faults.append(Fault(float(f["at_s"]), f["robot"], f["kind"], float(f.get("duration_s", 0.0))))
+    faults = load_faults(doc.get("faults"), FaultContext(path, {r.name: r for r in robots}, robot_types, backend,
+                                                         base_tree is not None))
     values = {k: doc.get(k, v) for k, v in DEFAULTS.items()}
     backend.check(doc, path, base_tree is not None)
     team = _team(doc, path, tree_types)
@@ -259,4 +244,4 @@ def load_scenario(path: str | Path) -> Scenario:
                     world=plain(doc["world"]), robots=robots, base_tree=base_tree,
                     base_position=base.get("position"), base_tick_hz=float(base.get("tick_hz", 1.0)),
                     radio=plain(doc.get("radio", {})), doc=doc, world_backend=backend, team=team, supervisor=supervisor,
-                    faults=sorted(faults, key=lambda f: f.at_s))
+                    faults=faults)

@@ -38,6 +38,12 @@ class RobotBody:
 
     @property
     def position(self) -> np.ndarray:
+        """Where the robot believes it is (the true position, unless its localisation drifts)."""
+        return self._pos.copy()
+
+    @property
+    def true_position(self) -> np.ndarray:
+        """Where the robot really is (the simulator's, for radio links and reports)."""
         return self._pos.copy()
 
     @property
@@ -55,6 +61,11 @@ class RobotBody:
     def endurance_remaining_s(self) -> float:
         return self._endurance
 
+    def drain_battery(self, fraction: float) -> None:
+        """A fault: the battery loses ``fraction`` (0..1] of the endurance it has left at
+        once; at zero the robot stops for good at its next step."""
+        self._endurance = max(0.0, self._endurance * (1.0 - float(fraction)))
+
     @property
     def distance_m(self) -> float:
         return self._distance
@@ -62,6 +73,11 @@ class RobotBody:
     @property
     def path_status(self) -> str:
         return self._status
+
+    @property
+    def parked(self) -> bool:
+        """Whether the robot was parked (its mission is over: it stands powered down)."""
+        return getattr(self, "_parked", False)
 
     @property
     def command_id(self) -> int:

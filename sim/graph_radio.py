@@ -38,7 +38,8 @@ class GraphRadioEndpoint(Endpoint):
 
 class GraphRadioNetwork:
     """All radios on a graph world. Two radios are linked when the locations nearest
-    to them are the same or share a communication edge, and neither is silent."""
+    to them are the same or share a communication edge, neither is off the air (silent
+    or blacked out) and their link is not cut."""
 
     def __init__(self, spec: GraphRadioSpec, world: GraphWorld, rng: np.random.Generator,
                  now_s: Callable[[], float]):
@@ -49,6 +50,8 @@ class GraphRadioNetwork:
         self.endpoints: dict[str, GraphRadioEndpoint] = {}
         self._positions: dict[str, Callable[[], np.ndarray]] = {}
         self._next_update_s = 0.0
+        #: Pairs of radios (sorted names) whose link is cut (a radio fault).
+        self.cut_links: set[tuple[str, str]] = set()
 
     def add(self, name: str, position: Callable[[], np.ndarray], **_: Any) -> GraphRadioEndpoint:
         ep = GraphRadioEndpoint(name, self)
@@ -62,7 +65,7 @@ class GraphRadioNetwork:
     def linked(self, a: str, b: str, where: dict[str, str] | None = None) -> bool:
         """Whether ``a`` and ``b`` can talk now (``where``: their locations, if known)."""
         ea, eb = self.endpoints.get(a), self.endpoints.get(b)
-        if ea is None or eb is None or ea.silent or eb.silent:
+        if ea is None or eb is None or ea.off_air or eb.off_air or (min(a, b), max(a, b)) in self.cut_links:
             return False
         at = where.__getitem__ if where is not None else self.where
         return self.world.can_communicate(at(a), at(b))

@@ -66,7 +66,7 @@ class GraphRobot(RobotBody):
 
     @property
     def alive(self) -> bool:
-        return self._alive
+        return self._alive and self._endurance > 0
 
     def follow_path(self, path: np.ndarray) -> None:
         self._commands += 1
@@ -171,7 +171,10 @@ class GraphRobot(RobotBody):
             return
         self._endurance = max(0.0, self._endurance - dt_s)
         if self._endurance == 0.0:
+            # The battery is flat: the robot stops for good and its radio falls silent.
             self._path, self._status, self.blocked_reason = [], BLOCKED, "endurance exhausted"
+            self._alive = False
+            self._radio.silent = True
             return
         if self._stuck_s > 0:
             self._stuck_s = max(0.0, self._stuck_s - dt_s)

@@ -229,7 +229,9 @@ class BreadcrumbDrop:
 
 class Endpoint:
     """What every radio has: an outbox its network sends from, an inbox it delivers
-    to, counters, and ``silent`` (a lost robot's radio sends nothing)."""
+    to, counters, ``silent`` (a lost robot's radio sends nothing, not even into its
+    outbox) and ``blackout`` (a radio fault: the node is off the network, but what is
+    sent waits in the outbox as it does while out of range)."""
 
     def __init__(self, name: str, now_s: Callable[[], float]):
         self.name = name
@@ -239,6 +241,12 @@ class Endpoint:
         self.sent = 0
         self.delivered = 0
         self.silent = False
+        self.blackout = False
+
+    @property
+    def off_air(self) -> bool:
+        """Whether the node takes no part in the network now (silent or blacked out)."""
+        return self.silent or self.blackout
 
     def send(self, recipient: str, kind: str, data: Any) -> None:
         if self.silent:
@@ -300,6 +308,10 @@ class RadioNetwork:
         self._graph = nx.Graph()
         self._routes: dict[str, tuple[dict[str, float], dict[str, list[str]]]] = {}
         self._next_update_s = 0.0
+        #: Pairs of nodes (sorted names) whose direct link is cut (a radio fault).
+        self.cut_links: set[tuple[str, str]] = set()
+        #: Deployed breadcrumbs that died before their battery ran out (a fault).
+        self.dead_breadcrumbs: set[str] = set()
 
     # ---- nodes ------------------------------------------------------------------
     def add(self, name: str, position: Callable[[], np.ndarray], *, breadcrumbs: int | None = None,
@@ -345,15 +357,15 @@ class RadioNetwork:
         return BreadcrumbDrop(True, owner, name, ep.breadcrumbs)
 
     def active_breadcrumbs(self) -> list[Breadcrumb]:
-        """Breadcrumbs whose battery still runs, by name."""
+        """Breadcrumbs whose battery still runs (and that did not die), by name."""
         now = self.now_s()
         return [b for n, b in sorted(self.breadcrumbs.items())
-                if now - b.deployed_s < self.spec.breadcrumb_battery_s]
+                if now - b.deployed_s < self.spec.breadcrumb_battery_s and n not in self.dead_breadcrumbs]
 
     def node_positions(self) -> dict[str, np.ndarray]:
-        """Current positions of every node (endpoints that are not silent, then active breadcrumbs)."""
+        """Current positions of every node (endpoints on the air, then active breadcrumbs)."""
         pos = {n: np.asarray(self._positions[n](), dtype=float).reshape(3) for n in sorted(self.endpoints)
-               if not self.endpoints[n].silent}
+               if not self.endpoints[n].off_air}
         pos.update({b.name: b.position.copy() for b in self.active_breadcrumbs()})
         return pos
 
@@ -460,7 +472,7 @@ class RadioNetwork:
             pa = np.array([pos[a] for a, _ in pairs])
             pb = np.array([pos[b] for _, b in pairs])
             for (a, b), budget in zip(pairs, self._budgets(pa, pb)):
-                if budget.linked:
+                if budget.linked and (min(a, b), max(a, b)) not in self.cut_links:
                     self._links[(min(a, b), max(a, b))] = budget
         graph = nx.Graph()
         graph.add_nodes_from(names)

@@ -6,6 +6,7 @@
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -31,7 +32,14 @@ class SimRobot(RobotBody):
     Legged robots keep their body ``body_height_m`` above the ground, refuse steps
     above ``max_step_m`` and ground inclinations above ``max_inclination_deg``
     (measured over ``inclination_window_m`` of travel). Aerial robots fly in 3D.
-    Endurance counts down with sim time; at zero the robot stops for good.
+    Endurance counts down with sim time; at zero the robot stops for good and its
+    radio falls silent.
+
+    Faults (injected by the executive's fault kinds): ``jam``, ``kill``,
+    ``inject_map_artifact``, ``drain_battery``, ``degrade_lidar`` /
+    ``restore_lidar`` and ``drift`` / ``relocalise``. With a localisation drift the
+    robot believes it stands at ``position`` = ``true_position`` + the drift: it
+    follows paths and integrates its scans in that believed frame.
     """
 
     inclination_window_m = 1.0
@@ -74,12 +82,22 @@ class SimRobot(RobotBody):
 
         self._stuck_s = 0.0
         self._parked = False
+        self._down = False
+        #: Localisation drift: believed minus true position, and how fast it grows (m/s of motion).
+        self._drift = np.zeros(3)
+        self._drift_mps = np.zeros(3)
 
         self._payload: PanTiltZoomCamera | None = None
 
-        self._sensors = [(spec, spec.beam_directions(0.0)) for spec in (platform.lidar, platform.terrain) if spec]
+        self._all_sensors = [(spec, spec.beam_directions(0.0)) for spec in (platform.lidar, platform.terrain) if spec]
+        self._sensors = list(self._all_sensors)
 
     # ---- the robot interface (the rest in RobotBody) ----------------------------
+    @property
+    def position(self) -> np.ndarray:
+        """Where the robot believes it is: its true position plus its localisation drift."""
+        return self._pos + self._drift
+
     @property
     def yaw_rad(self) -> float:
         return self._yaw
@@ -134,7 +152,7 @@ class SimRobot(RobotBody):
 
     @property
     def alive(self) -> bool:
-        return self._endurance > 0
+        return not self._down and self._endurance > 0
 
     def jam(self, duration_s: float) -> None:
         """A fault: the feet (or rotors) are stuck for ``duration_s``; a path being
@@ -145,6 +163,7 @@ class SimRobot(RobotBody):
         """A fault: the robot dies where it stands; it stops and its radio falls silent."""
         self.stop()
         self._endurance = 0.0
+        self._down = True
         self._radio.silent = True
 
     def inject_map_artifact(self, radius_m: float = 1.5) -> None:
@@ -152,13 +171,46 @@ class SimRobot(RobotBody):
         onboard map all around it, as odometry drift leaves in a real map, so planners
         find its start pose invalid."""
         self.stop()
-        self._map.set_sphere(self._pos, radius_m, OCCUPIED)
+        self._map.set_sphere(self.position, radius_m, OCCUPIED)
+
+    def degrade_lidar(self, range_m: float | None = None, ray_fraction: float = 1.0) -> None:
+        """A fault: every range sensor (the LiDAR, a legged robot's terrain cameras)
+        reaches at most ``range_m`` and keeps ``ray_fraction`` of its beams (0: a
+        dropout, the sensors return nothing); :meth:`restore_lidar` ends it."""
+        self._sensors = []
+        for spec, beams in self._all_sensors:
+            if range_m is not None and range_m < spec.range_m:
+                spec = replace(spec, range_m=float(range_m))
+            keep = (np.arange(len(beams)) * _GOLDEN) % 1.0 < ray_fraction
+            if keep.any():
+                self._sensors.append((spec, beams[keep]))
+
+    def restore_lidar(self) -> None:
+        """The range sensors work again as the platform has them."""
+        self._sensors = list(self._all_sensors)
+
+    def drift(self, velocity_mps: np.ndarray) -> None:
+        """A fault: from now on the believed position drifts from the true one by
+        ``velocity_mps`` (3,) per second of motion; zero stops the drift (what has
+        drifted stays until :meth:`relocalise`)."""
+        self._drift_mps = np.asarray(velocity_mps, dtype=float).reshape(3).copy()
+
+    def relocalise(self) -> None:
+        """The state estimator finds its true pose again: the drift is gone (the map
+        keeps what it integrated while drifting)."""
+        self._drift_mps = np.zeros(3)
+        self._drift = np.zeros(3)
+
+    @property
+    def drift_m(self) -> float:
+        """How far the believed position is from the true one now."""
+        return float(np.linalg.norm(self._drift))
 
 
     def reset_local_map(self, radius_m: float) -> None:
         """Forget the onboard map within ``radius_m`` of the robot (the next scans
         map it again), as the paper's behaviour tree resets the elevation map."""
-        self._map.set_sphere(self._pos, radius_m, UNKNOWN)
+        self._map.set_sphere(self.position, radius_m, UNKNOWN)
 
     def park(self) -> None:
         """Stop and power down: endurance no longer counts down (the mission is over)."""
@@ -181,23 +233,29 @@ class SimRobot(RobotBody):
 
     # ---- simulation ------------------------------------------------------------
     def step(self, dt_s: float) -> None:
-        """Advance endurance and motion by one sim step."""
-        if not self.alive or self._parked:
+        """Advance endurance and motion by one sim step. When the endurance runs out
+        the robot stops for good (path BLOCKED, "endurance exhausted") and its radio
+        falls silent."""
+        if self._down or self._parked:
             return
         self._endurance = max(0.0, self._endurance - dt_s)
         if self._endurance == 0.0:
             self._path = None
             self._status = BLOCKED
             self.blocked_reason = "endurance exhausted"
+            self._down = True
+            self._radio.silent = True
             return
         if self._status != FOLLOWING or self._path is None:
             return
         if self._stuck_s > 0:
             self._stuck_s = max(0.0, self._stuck_s - dt_s)
             return
+        if self._drift_mps.any():
+            self._drift = self._drift + self._drift_mps * dt_s
         budget = self._platform.speed_mps * dt_s
         while budget > 1e-9 and self._status == FOLLOWING:
-            target = self._path[self._wp]
+            target = self._path[self._wp] - self._drift
             delta = target - self._pos
             if not self._platform.aerial:
                 delta[2] = 0.0
@@ -242,7 +300,7 @@ class SimRobot(RobotBody):
         self._trail_since += step
         self._pos = new
         if self._trail_since >= self.trail_spacing_m:
-            self._trail.append(new.copy())
+            self._trail.append(new + self._drift)
             self._trail_since = 0.0
         return True
 
@@ -272,5 +330,5 @@ class SimRobot(RobotBody):
             c, s = math.cos(yaw), math.sin(yaw)
             dirs = np.stack([c * beams[:, 0] - s * beams[:, 1], s * beams[:, 0] + c * beams[:, 1], beams[:, 2]], axis=1)
             ranges = self.world.cast_rays(np.broadcast_to(sensor, dirs.shape), dirs, spec.range_m)
-            self._map.integrate_scan(sensor, dirs, ranges, spec.range_m)
+            self._map.integrate_scan(sensor + self._drift, dirs, ranges, spec.range_m)
         self._scans += 1

@@ -16,6 +16,7 @@ from py_trees.common import Status
 from ...skills.base import Param
 
 if TYPE_CHECKING:
+    from ..agent import Agent
     from ..runner import Mission
 
 
@@ -55,9 +56,20 @@ class TeamStrategy(ABC):
         """Whether the mission is over."""
         return all(a.finished for a in mission.robot_agents)
 
+    def judged_agents(self, mission: "Mission") -> list["Agent"]:
+        """The agents whose trees must end in SUCCESS: every robot's (robots lost to a
+        fault or a flat battery aside)."""
+        return mission.robot_agents
+
     def succeeded(self, mission: "Mission") -> bool:
-        """Whether the mission succeeded (asked once it is over)."""
-        return all(a.root.status == Status.SUCCESS for a in mission.robot_agents)
+        """Whether the team did its part (asked once it is over): every judged agent's
+        tree ended in SUCCESS. The mission's verdict adds its own checks to this for
+        every strategy (:mod:`delve.executive.outcome`)."""
+        return all(a.root.status == Status.SUCCESS for a in self.judged_agents(mission))
+
+    def restarted(self, mission: "Mission", name: str) -> None:
+        """Agent ``name``'s tree was built afresh (a base-station restart): find again
+        what the strategy holds of it."""
 
     def explored_at_base(self) -> set[str]:
         """The locations the base station knows to be explored (worlds of locations
@@ -67,6 +79,13 @@ class TeamStrategy(ABC):
     def figures(self, mission: "Mission") -> dict[str, Any]:
         """This strategy's figures for ``report.json`` (deterministic ones)."""
         return {}
+
+    def robot_figures(self, mission: "Mission", name: str) -> dict[str, Any]:
+        """This strategy's figures of robot ``name``: by default what it mapped that
+        never reached the base station's map (``map_voxels_undelivered``), on worlds
+        with one."""
+        voxels = mission.backend.map_undelivered(name)
+        return {} if voxels is None else {"map_voxels_undelivered": voxels}
 
     def wall_clock_figures(self, mission: "Mission") -> dict[str, Any]:
         """This strategy's figures that depend on the wall clock (``WALL_CLOCK_FIELDS``)."""

@@ -23,7 +23,13 @@ from .base import TeamStrategy
 from .cops_report import cops_figures, declared_lost, solve_time_figures
 
 if TYPE_CHECKING:
+    from ..agent import Agent
     from ..runner import Mission
+
+
+def _cops_skill(root: Any) -> CopsSkill | None:
+    """The first COPS behaviour of a tree (it reads the agent's COPS state)."""
+    return next((b for b in root.iterate() if isinstance(b, CopsSkill)), None)
 
 
 class Cops(TeamStrategy):
@@ -52,7 +58,7 @@ class Cops(TeamStrategy):
         base = mission.agents[BASE]
         base.ctx.services.update(team=net.team, base_location=net.base_location,
                                  initial_topology=net.initial_topology)
-        self._leader = next((b for b in base.root.iterate() if isinstance(b, CopsSkill)), None)
+        self._leader = _cops_skill(base.root)
 
     def base_state(self) -> CopsState | None:
         """The base station's COPS state (None before its first tick)."""
@@ -70,8 +76,23 @@ class Cops(TeamStrategy):
         stranded = set(self.stranded())
         return base.finished and all(a.finished or a.name in stranded for a in mission.robot_agents)
 
-    def succeeded(self, mission: "Mission") -> bool:
-        return super().succeeded(mission) and mission.agents[BASE].root.status == Status.SUCCESS
+    def judged_agents(self, mission: "Mission") -> list["Agent"]:
+        """The robots and the base station (the leader)."""
+        return [*mission.robot_agents, mission.agents[BASE]]
+
+    def restarted(self, mission: "Mission", name: str) -> None:
+        if name == BASE:
+            self._leader = _cops_skill(mission.agents[BASE].root)
+
+    def robot_figures(self, mission: "Mission", name: str) -> dict[str, Any]:
+        """``locations_undelivered``: locations the robot knows explored that the base
+        station does not (what a lost robot took with it). Graph-world radios drop
+        datagrams, so its ``messages_undelivered`` stays 0; a COPS team shares
+        locations, not maps, so no ``map_voxels_undelivered``."""
+        skill = _cops_skill(mission.agents[name].root)
+        st = skill.stored_state() if skill is not None else None
+        held = set(st.knowledge.topology.explored) if st is not None else set()
+        return {"locations_undelivered": len(held - self.explored_at_base())}
 
     def explored_at_base(self) -> set[str]:
         st = self.base_state()

@@ -63,7 +63,8 @@ class WorldBackend(ABC):
     KEYS: ClassVar[tuple[str, ...]] = ()
     #: What the coverage plot's fraction counts.
     COVERAGE_LABEL: ClassVar[str] = "fraction explored"
-    #: Fault kinds this world cannot inject (``faults:`` in a scenario).
+    #: Fault kinds this world cannot inject (``faults:`` in a scenario; a fault kind
+    #: may also name the worlds it applies to, ``Fault.WORLDS``).
     UNSUPPORTED_FAULTS: ClassVar[tuple[str, ...]] = ()
 
     world: Any
@@ -91,10 +92,6 @@ class WorldBackend(ABC):
         if "generator" in world:
             params = inspect.signature(cls.generators()[world["generator"]]).parameters
             only_keys(world, ("generator", *params), "world: unknown parameter", path)
-        for i, fault in enumerate(doc.get("faults", [])):
-            if fault["kind"] in cls.UNSUPPORTED_FAULTS:
-                raise DelveError(f"a {fault['kind']!r} fault does not apply to this world", path,
-                                 doc["faults"].item_line(i))
 
     @classmethod
     @abstractmethod
@@ -130,9 +127,14 @@ class WorldBackend(ABC):
         """The report's figures of this world (before the team strategy's)."""
         return {}
 
-    def robot_figures(self, name: str, lost: set[str]) -> dict[str, Any]:
-        """The report's extra figures of robot ``name``."""
+    def robot_figures(self, name: str, lost: "Mapping[str, str]") -> dict[str, Any]:
+        """The report's extra figures of robot ``name`` (``lost``: the robots lost and why)."""
         return {}
+
+    def map_undelivered(self, name: str) -> int | None:
+        """Voxels robot ``name`` mapped that the base station's map does not hold;
+        None on worlds without maps."""
+        return None
 
     @abstractmethod
     def plot_map(self, mission: "Mission", path: Path) -> None:

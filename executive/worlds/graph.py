@@ -120,7 +120,7 @@ class GraphBackend(WorldBackend):
                 "all_known_at_base_s": next((s.t for s in mission.state.samples if s.base >= 1.0), None),
                 "lost_robots": sorted(mission.lost)}
 
-    def robot_figures(self, name: str, lost: set[str]) -> dict[str, Any]:
+    def robot_figures(self, name: str, lost: Mapping[str, str]) -> dict[str, Any]:
         robot = self.robots[name]
         return {"transitions": robot.transitions, "locations_explored": len(robot.explored),
                 "lost": name in lost, "messages_dropped": robot.radio.dropped}

@@ -14,7 +14,7 @@ from ...sim.clock import SimClock
 from ...sim.platforms import PLATFORMS
 from ...sim.radio import RadioNetwork, RadioSpec
 from ...sim.robot import SimRobot
-from ...sim.voxel_map import VoxelMap
+from ...sim.voxel_map import UNKNOWN, VoxelMap
 from ...sim.world import World
 from ...skills.base import AgentContext
 from ...skills.cops.voxel_view import VoxelNetworkView
@@ -98,7 +98,7 @@ class VoxelBackend(WorldBackend):
         platform = replace(base, **spec.overrides, lidar=replace(base.lidar, **spec.lidar))
         start = np.asarray(spec.start, float) if spec.start is not None else self._free_start(index)
         holder: dict[str, SimRobot] = {}
-        radio = self.radio.add(spec.name, lambda: holder["r"].position, breadcrumbs=spec.breadcrumbs)
+        radio = self.radio.add(spec.name, lambda: holder["r"].true_position, breadcrumbs=spec.breadcrumbs)
         robot = SimRobot(spec.name, platform, self.world, start, radio, spec.endurance_s)
         holder["r"] = robot
         return robot
@@ -122,7 +122,8 @@ class VoxelBackend(WorldBackend):
 
     def sense(self, now_s: float) -> None:
         for name, robot in self.robots.items():
-            if robot.alive and now_s + 1e-9 >= self._next_scan[name]:
+            # A parked robot stands powered down: it no longer scans.
+            if robot.alive and not robot.parked and now_s + 1e-9 >= self._next_scan[name]:
                 self._scan(name, now_s)
 
     def _scan(self, name: str, now_s: float) -> None:
@@ -164,8 +165,13 @@ class VoxelBackend(WorldBackend):
     def figures(self, mission: "Mission") -> dict[str, Any]:
         return {"free_volume_m3": round(len(self.truth) * self.world.voxel_size_m ** 3, 1)}
 
-    def robot_figures(self, name: str, lost: set[str]) -> dict[str, Any]:
+    def robot_figures(self, name: str, lost: Mapping[str, str]) -> dict[str, Any]:
         return {"lost": name in lost} if lost else {}
+
+    def map_undelivered(self, name: str) -> int:
+        """Voxels robot ``name`` knows (free or rock) that are unknown in the base map."""
+        onboard = self.robots[name].onboard_map.occupancy
+        return int(np.count_nonzero((onboard != UNKNOWN) & (self.base_map.occupancy == UNKNOWN)))
 
     def plot_map(self, mission: "Mission", path: Path) -> None:
         plot_voxel_map(mission, self.truth, path)
