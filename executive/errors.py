@@ -14,6 +14,8 @@ import warnings
 from collections.abc import Iterable
 from pathlib import Path
 
+from ..skills.base import short_repr
+
 
 def display_path(path: str | os.PathLike[str]) -> str:
     """``path`` as a user should read it: relative to the working directory when it
@@ -70,7 +72,7 @@ class DelveError(Exception):
             if self.line is not None:
                 where += f":{self.line}"
             where += ": "
-        suffix = f" [node {self.node!r}]" if self.node else ""
+        suffix = f" [node {short_repr(self.node)}]" if self.node else ""
         return f"{where}{self.message}{suffix}"
 
     def __reduce__(self):  # keep file/line/node across pickling (multiprocessing)
