@@ -22,7 +22,7 @@ from typing import Any
 from py_trees import behaviours, common, composites, decorators, idioms
 from py_trees.behaviour import Behaviour
 
-from ..skills.base import REQUIRED, Param
+from ..skills.base import REQUIRED, Param, short_repr
 from ..skills.timing import Timeout as SimTimeout
 from .errors import did_you_mean
 from .node_types import Build, Builder, NodeType, first_paragraph
@@ -83,10 +83,11 @@ def _comparison(b: Build, param: str, index: int, item: Any) -> common.Compariso
     """A ``{variable_name, value, operator}`` mapping as a py_trees ComparisonExpression."""
     if not isinstance(item, dict):
         b.fail(f"'{param}' item {index + 1} must be a mapping with variable_name, value, operator", param, index)
-    unknown = sorted(set(item) - _COMPARISON_KEYS)
+    unknown = [key for key in item if key not in _COMPARISON_KEYS]
     if unknown:
         b.fail(
-            f"unknown key {unknown[0]!r} in '{param}' item {index + 1}{did_you_mean(unknown[0], _COMPARISON_KEYS)}",
+            f"unknown key {short_repr(unknown[0])} in '{param}' item {index + 1}"
+            f"{did_you_mean(str(unknown[0]), _COMPARISON_KEYS)}",
             param,
             index,
         )
@@ -97,9 +98,10 @@ def _comparison(b: Build, param: str, index: int, item: Any) -> common.Compariso
     if not isinstance(var, str) or not var:
         b.fail(f"'{param}' item {index + 1}: variable_name must be a non-empty string", param, index)
     op = item.get("operator", "==")
-    if op not in OPERATORS:
+    if not isinstance(op, str) or op not in OPERATORS:
         b.fail(
-            f"'{param}' item {index + 1}: operator must be one of {', '.join(map(repr, OPERATORS))}, got {op!r}",
+            f"'{param}' item {index + 1}: operator must be one of {', '.join(map(repr, OPERATORS))}, "
+            f"got {short_repr(op)}",
             param,
             index,
         )
@@ -113,8 +115,9 @@ def _comparisons(b: Build, param: str) -> list[common.ComparisonExpression]:
 def _status_list(b: Build, param: str) -> list[common.Status]:
     out = []
     for i, item in enumerate(b.params[param]):
-        if item not in STATUSES:
-            b.fail(f"'{param}' item {i + 1} must be one of {', '.join(map(repr, STATUSES))}, got {item!r}", param, i)
+        if not isinstance(item, str) or item not in STATUSES:
+            b.fail(f"'{param}' item {i + 1} must be one of {', '.join(map(repr, STATUSES))}, got {short_repr(item)}",
+                   param, i)
         out.append(STATUSES[item])
     return out
 
@@ -147,13 +150,14 @@ def _parallel(b: Build) -> Behaviour:
         by_name: dict[str, Behaviour] = {}
         for child in b.children:
             if child.name in by_name and child.name in selected:
-                b.fail(f"two children are named {child.name!r}; 'selected' cannot tell them apart", "selected")
+                b.fail(f"two children are named {short_repr(child.name)}; 'selected' cannot tell them apart",
+                       "selected")
             by_name[child.name] = child
         chosen = []
         for i, child_name in enumerate(selected):
-            if child_name not in by_name:
+            if not isinstance(child_name, str) or child_name not in by_name:
                 b.fail(
-                    f"'selected' names no child {child_name!r}{did_you_mean(str(child_name), by_name)}",
+                    f"'selected' names no child {short_repr(child_name)}{did_you_mean(str(child_name), by_name)}",
                     "selected",
                     i,
                 )
@@ -562,7 +566,8 @@ def _pick_up_where_you_left_off(b: Build) -> Behaviour:
     for child in b.children:
         flag = f"{_slug(child.name)}_done"
         if flag in flags.values():
-            b.fail(f"children of pick_up_where_you_left_off need distinct names; {child.name!r} repeats", "children")
+            b.fail(f"children of pick_up_where_you_left_off need distinct names; {short_repr(child.name)} repeats",
+                   "children")
         flags[child.name] = b.key(flag)
     root = composites.Sequence(name=b.name, memory=True)
     for task in b.children:

@@ -1,8 +1,8 @@
 """The ``delve`` command line.
 
-    delve run SCENARIO [--out DIR] [--seed N] [--duration-s S] [--quiet]
-    delve validate FILE... | --shipped
-    delve render TREE --format svg|dot|png|txt [--out PATH]
+    delve run SCENARIO [--out DIR] [--seed N] [--duration-s S] [--quiet] [--include-path DIR]...
+    delve validate FILE... | --shipped [--include-path DIR]...
+    delve render TREE --format svg|dot|png|txt [--out PATH] [--include-path DIR]...
     delve demo
 
 Exit status: 0 when the mission succeeds (every robot's tree ends in SUCCESS, every
@@ -41,6 +41,10 @@ def _parser() -> argparse.ArgumentParser:
     ren.add_argument("tree", type=Path)
     ren.add_argument("--format", choices=("svg", "dot", "png", "txt"), default="txt")
     ren.add_argument("--out", type=Path, help="output file (default: TREE with the format's suffix)")
+    for command in (run, val, ren):
+        command.add_argument("--include-path", type=Path, action="append", default=[], metavar="DIR",
+                             help="a folder that tree includes may also resolve into (besides the tree's own "
+                                  "folder and the shipped trees); repeatable")
     demo = sub.add_parser("demo", help="run the default scenario into ./delve-out/demo")
     demo.add_argument("--quiet", action="store_true")
     return p
@@ -58,19 +62,30 @@ def main(argv: list[str] | None = None) -> int:
         return _command(args)
 
 
+def _include_path(args: argparse.Namespace) -> tuple[Path, ...]:
+    """The --include-path folders, each checked to be one."""
+    folders = tuple(getattr(args, "include_path", None) or ())
+    for folder in folders:
+        if not folder.is_dir():
+            raise DelveError(f"--include-path {str(folder)!r} is not a folder")
+    return folders
+
+
 def _command(args: argparse.Namespace) -> int:
     try:
+        include_path = _include_path(args)
         if args.command == "run":
-            return run(shipped_or_given(args.scenario), args.out, args.seed, args.duration_s, args.quiet)
+            return run(shipped_or_given(args.scenario), args.out, args.seed, args.duration_s, args.quiet,
+                       include_path)
         if args.command == "demo":
             return run(DEMO_SCENARIO, Path("delve-out/demo"), None, None, args.quiet)
         if args.command == "validate":
             shipped = sorted(TREES_DIR.rglob("*.yaml")) + sorted(SCENARIOS_DIR.glob("*.yaml")) if args.shipped else []
             if not args.files and not shipped:
                 raise DelveError("validate: name the files to check, or --shipped")
-            return validate(args.files + shipped)
+            return validate(args.files + shipped, include_path)
         if args.command == "render":
-            return render(args.tree, args.format, args.out)
+            return render(args.tree, args.format, args.out, include_path)
     except DelveError as err:
         print(err, file=sys.stderr)
         return 2
@@ -86,8 +101,10 @@ def shipped_or_given(path: Path) -> Path:
     return path
 
 
-def run(path: Path, out: Path | None, seed: int | None, duration_s: float | None, quiet: bool) -> int:
-    """Run a scenario, write its outputs, print a summary; exit status per the mission."""
+def run(path: Path, out: Path | None, seed: int | None, duration_s: float | None, quiet: bool,
+        include_path: tuple[Path, ...] = ()) -> int:
+    """Run a scenario, write its outputs, print a summary; exit status per the mission.
+    ``include_path``: folders the trees' includes may also resolve into."""
     from .outputs import write_outputs
     from .runner import Mission
     from .scenario import load_scenario
@@ -96,7 +113,7 @@ def run(path: Path, out: Path | None, seed: int | None, duration_s: float | None
         raise DelveError(f"--seed must be >= 0, got {seed}")
     if duration_s is not None and not duration_s > 0:
         raise DelveError(f"--duration-s must be > 0, got {duration_s}")
-    scenario = load_scenario(path)
+    scenario = load_scenario(path, include_path=include_path)
     out = out or Path("delve-out") / scenario.name
     started = time.perf_counter()
     mission = Mission(scenario, seed=seed, duration_s=duration_s)
@@ -138,20 +155,21 @@ def _run_with_progress(mission) -> None:
         bar.update(task, completed=mission.duration_s)
 
 
-def validate(files: list[Path]) -> int:
-    """Check each file; print ``ok`` or the error. Exit 2 if any file is wrong."""
-    from .scenario import load_scenario
+def validate(files: list[Path], include_path: tuple[Path, ...] = ()) -> int:
+    """Check each file (a scenario when its top level has a scenario's keys, or near
+    misses of them; else a tree); print ``ok`` or the error. Exit 2 if any file is wrong."""
+    from .scenario import load_scenario, scenario_keys
     from .tree_loader import check_tree
 
     status = 0
     for f in files:
         try:
             doc = load_yaml(f)
-            if isinstance(doc, YamlDict) and ("robots" in doc or "world" in doc):
-                scenario = load_scenario(f)
+            if isinstance(doc, YamlDict) and scenario_keys(doc):
+                scenario = load_scenario(f, include_path=include_path)
                 scenario.check_starts(scenario.build_world())
             else:
-                check_tree(f)
+                check_tree(f, include_path=include_path)
             print(f"ok: {f}")
         except DelveError as err:
             print(err, file=sys.stderr)
@@ -159,13 +177,13 @@ def validate(files: list[Path]) -> int:
     return status
 
 
-def render(tree: Path, fmt: str, out: Path | None) -> int:
+def render(tree: Path, fmt: str, out: Path | None, include_path: tuple[Path, ...] = ()) -> int:
     from ..skills.base import AgentContext
     from .render import render_tree
     from .tree_loader import load_tree
 
     ctx = AgentContext(name="render", namespace="/render", clock=_Still(), log=lambda *a, **k: None)
-    root = load_tree(tree, ctx)
+    root = load_tree(tree, ctx, include_path=include_path)
     out = out or tree.with_suffix(f".{fmt}")
     render_tree(root, fmt, out)
     print(f"wrote {out}")

@@ -101,13 +101,14 @@ class Mission:
         for spec in self.scenario.robots:
             ctx = self._context(spec.name, self.robots[spec.name])
             ctx.services.update(self.team.robot_services(spec.name))
-            self.agents[spec.name] = Agent(spec.name, load_tree(spec.tree, ctx), 1.0 / spec.tick_hz, ctx,
-                                           on_change=self._status_changed)
+            tree = load_tree(spec.tree, ctx, include_path=self.scenario.include_path)
+            self.agents[spec.name] = Agent(spec.name, tree, 1.0 / spec.tick_hz, ctx, on_change=self._status_changed)
         if self.scenario.base_tree is not None:
             ctx = self._context(BASE, None)
             ctx.services.update(self.backend.base_services())
             ctx.services.update(self.team.base_services())
-            self.agents[BASE] = Agent(BASE, load_tree(self.scenario.base_tree, ctx),
+            self.agents[BASE] = Agent(BASE, load_tree(self.scenario.base_tree, ctx,
+                                                      include_path=self.scenario.include_path),
                                       1.0 / self.scenario.base_tick_hz, ctx, on_change=self._status_changed)
 
     def _context(self, name: str, robot: Any) -> AgentContext:
@@ -205,7 +206,8 @@ class Mission:
         radio.inbox.clear()
         radio.outbox.clear()
         tree = self.scenario.base_tree if name == BASE else next(r.tree for r in self.scenario.robots if r.name == name)
-        self.agents[name] = Agent(name, load_tree(tree, ctx), old.period_s, ctx, on_change=self._status_changed,
+        root = load_tree(tree, ctx, include_path=self.scenario.include_path)
+        self.agents[name] = Agent(name, root, old.period_s, ctx, on_change=self._status_changed,
                                   next_tick_s=resume_s)
         self.team.restarted(self, name)
         return lost

@@ -10,7 +10,7 @@ import math
 from dataclasses import dataclass, field
 from functools import lru_cache
 from pathlib import Path
-from typing import Any
+from typing import Any, Iterable
 
 import jsonschema
 
@@ -20,6 +20,7 @@ from .faults.loader import load_faults
 from .supervisor import Command, load_supervisor
 from .teams import DEFAULT_STRATEGY, TEAM_STRATEGIES, TeamStrategy, implied_strategy
 from .worlds import WorldBackend, backend_for, generator_names
+from ..skills.base import short_repr, yaml_number_hint
 from .yamlio import YamlDict, YamlList, load_yaml, plain
 
 SCHEMA_PATH = Path(__file__).parent / "schema" / "scenario.schema.json"
@@ -77,6 +78,8 @@ class Scenario:
     team: TeamSpec
     supervisor: list[Command] = field(default_factory=list)
     faults: list[Fault] = field(default_factory=list)
+    #: Folders the trees' includes may resolve into besides their own and the shipped trees.
+    include_path: tuple[Path, ...] = ()
 
     def team_strategy(self) -> TeamStrategy:
         """A fresh instance of the scenario's team strategy."""
@@ -95,15 +98,44 @@ class Scenario:
                 continue
             problem = world.start_problem(r.start)
             if problem:
-                raise DelveError(f"robot {r.name!r}: start pose {r.start} is {problem}", self.path, r.start_line)
+                raise DelveError(f"robot {short_repr(r.name)}: start pose {r.start} is {problem}", self.path,
+                                 r.start_line)
         if self.base_position is not None:
             problem = world.start_problem(self.base_position)
             if problem:
-                raise DelveError(f"base station position is {problem}", self.path, self.doc["base_station"].line)
+                raise DelveError(f"base station position is {problem}", self.path,
+                                 self.doc["base_station"].key_line("position"))
+
+
+#: Top-level keys that only a scenario has (a tree node may have a name too).
+_SCENARIO_ONLY_KEYS = ("world", "robots", "base_station", "radio", "team", "supervisor", "faults")
+
+
+def scenario_keys(mapping: Any) -> list[str]:
+    """The keys that make ``mapping`` (a file's top level) a scenario rather than a
+    tree: keys only a scenario has, or near misses of them (``wrold``), in file order.
+    [] for a tree node (it has, or nearly has, 'type' or 'include')."""
+    if not isinstance(mapping, dict):
+        return []
+    keys = [k for k in mapping if isinstance(k, str)]
+    if any(k in ("type", "include") or did_you_mean(k, ("type", "include")) for k in keys):
+        return []
+    return [k for k in keys if k in _SCENARIO_ONLY_KEYS or did_you_mean(k, _SCENARIO_ONLY_KEYS)]
+
+
+def _where(path: Any) -> str:
+    return "/".join(short_repr(p)[1:-1] if isinstance(p, str) else str(p) for p in path) or "scenario"
+
+
+def _schema_rank(err: jsonschema.ValidationError) -> tuple:
+    """Which error to report first: the shallowest, then an unknown key (a typo
+    explains the rest), then in file order."""
+    return (len(err.absolute_path), err.validator != "additionalProperties", list(map(str, err.absolute_path)))
 
 
 def _schema_error(err: jsonschema.ValidationError, doc: Any, path: Path) -> DelveError:
-    """Turn a JSON Schema error into one line at the offending key."""
+    """Turn a JSON Schema error into one line at the offending key; it quotes at most
+    a few dozen characters of the offending value."""
     node, line = doc, getattr(doc, "line", None)
     for part in err.absolute_path:
         if isinstance(node, YamlDict):
@@ -111,32 +143,48 @@ def _schema_error(err: jsonschema.ValidationError, doc: Any, path: Path) -> Delv
         elif isinstance(node, YamlList):
             line = node.item_line(part) or line
         node = node[part]
-    where = "/".join(str(p) for p in err.absolute_path) or "scenario"
+    where = _where(err.absolute_path)
     if err.validator == "additionalProperties":
         allowed = err.schema.get("properties", {})
-        extra = sorted(set(node) - set(allowed))
+        extra = [k for k in node if k not in allowed]
         key = extra[0] if extra else "?"
         if isinstance(node, YamlDict):
             line = node.key_line(key) or line
-        return DelveError(f"{where}: unknown key {key!r}{did_you_mean(key, allowed)}", path, line)
+        return DelveError(f"{where}: unknown key {short_repr(key)}{did_you_mean(str(key), allowed)}", path, line)
     if err.validator == "required":
         return DelveError(f"{where}: {err.message.replace(' is a required property', '')} is missing", path, line)
     if err.validator == "oneOf" and where == "world":
         return DelveError("world: give one of 'generator', 'mesh' or 'network'", path, line)
     if err.validator == "enum":
         choices = ", ".join(map(repr, err.validator_value))
-        return DelveError(f"{where}: {err.instance!r} is not one of {choices}", path, line)
-    return DelveError(f"{where}: {err.message}", path, line)
+        return DelveError(f"{where}: {short_repr(err.instance)} is not one of {choices}", path, line)
+    message = err.message
+    shown = repr(err.instance)
+    if len(shown) > len(short_repr(err.instance)):
+        message = message.replace(shown, short_repr(err.instance))
+    if len(message) > 160:
+        message = message[:160] + "..."
+    if err.validator == "type" and {"number", "integer"} & set(_as_list(err.validator_value)):
+        message += yaml_number_hint(err.instance, integer="number" not in _as_list(err.validator_value))
+    return DelveError(f"{where}: {message}", path, line)
 
 
-def _nan(doc: Any, path: Path) -> None:
-    """Reject NaN and infinite numbers anywhere in the file."""
+def _as_list(value: Any) -> list:
+    return value if isinstance(value, list) else [value]
+
+
+def _nan(doc: Any, path: Path, where: tuple = ()) -> None:
+    """Reject NaN and infinite numbers, and integers too large for a number, anywhere
+    in the file; the error names the value's path (``robots/0/start/0``)."""
     items = doc.items() if isinstance(doc, dict) else enumerate(doc) if isinstance(doc, list) else ()
     for k, v in items:
-        if isinstance(v, float) and not math.isfinite(v):
+        bad = isinstance(v, float) and not math.isfinite(v)
+        huge = isinstance(v, int) and not isinstance(v, bool) and abs(v) > 2.0 ** 1023
+        if bad or huge:
             line = doc.key_line(k) if isinstance(doc, YamlDict) else doc.item_line(k)
-            raise DelveError(f"{k}: must be a finite number, not {v}", path, line)
-        _nan(v, path)
+            what = f"not {v}" if bad else f"not an integer of {len(str(abs(v)))} digits"
+            raise DelveError(f"{_where((*where, k))}: must be a finite number, {what}", path, line)
+        _nan(v, path, (*where, k))
 
 
 def _world_backend(doc: YamlDict, path: Path) -> type[WorldBackend]:
@@ -146,7 +194,7 @@ def _world_backend(doc: YamlDict, path: Path) -> type[WorldBackend]:
     if backend is None:
         names = generator_names()
         name = world.get("generator")
-        raise DelveError(f"world/generator: {name!r} is not one of {', '.join(map(repr, names))}"
+        raise DelveError(f"world/generator: {short_repr(name)} is not one of {', '.join(map(repr, names))}"
                          f"{did_you_mean(str(name), names)}", path, world.key_line("generator") or world.line)
     return backend
 
@@ -167,7 +215,7 @@ def _team(doc: YamlDict, path: Path, tree_types: set[type]) -> TeamSpec:
         return TeamSpec(TEAM_STRATEGIES[name], {})
     name = team["strategy"]
     if name not in TEAM_STRATEGIES:
-        raise DelveError(f"team: unknown strategy {name!r}{did_you_mean(name, TEAM_STRATEGIES)} "
+        raise DelveError(f"team: unknown strategy {short_repr(name)}{did_you_mean(name, TEAM_STRATEGIES)} "
                          f"(one of {', '.join(map(repr, TEAM_STRATEGIES))})", path, team.key_line("strategy"))
     strategy = TEAM_STRATEGIES[name]
     needed = implied_strategy(tree_types)
@@ -180,7 +228,7 @@ def _team(doc: YamlDict, path: Path, tree_types: set[type]) -> TeamSpec:
             continue
         spec = strategy.PARAMS.get(key)
         if spec is None:
-            raise DelveError(f"team: unknown parameter {key!r} of strategy {name!r}"
+            raise DelveError(f"team: unknown parameter {short_repr(key)} of strategy {name!r}"
                              f"{did_you_mean(key, strategy.PARAMS)}", path, team.key_line(key))
         problem = spec.problem(value)
         if problem:
@@ -189,17 +237,24 @@ def _team(doc: YamlDict, path: Path, tree_types: set[type]) -> TeamSpec:
     return TeamSpec(strategy, params)
 
 
-def load_scenario(path: str | Path) -> Scenario:
-    """Read and check a scenario file (not its world: see :meth:`Scenario.build_world`)."""
+def load_scenario(path: str | Path, include_path: Iterable[str | Path] = ()) -> Scenario:
+    """Read and check a scenario file (not its world: see :meth:`Scenario.build_world`).
+    ``include_path``: folders its trees' includes may also resolve into."""
+    include_path = tuple(Path(p) for p in include_path)
     path = Path(path)
     doc = load_yaml(path)
     if not isinstance(doc, YamlDict):
         raise DelveError("a scenario file must be a mapping", path, getattr(doc, "line", 1))
+    if ("type" in doc or "include" in doc) and not scenario_keys({k: v for k, v in doc.items()
+                                                                  if k not in ("type", "include")}):
+        key = "type" if "type" in doc else "include"
+        raise DelveError(f"{path.name} is a tree, not a scenario: a scenario names its trees "
+                         "(robots: - tree: ...)", path, doc.key_line(key))
     _nan(doc, path)
-    errors = sorted(jsonschema.Draft202012Validator(scenario_schema()).iter_errors(doc),
-                    key=lambda e: (len(e.absolute_path), list(map(str, e.absolute_path))))
+    errors = sorted(jsonschema.Draft202012Validator(scenario_schema()).iter_errors(doc), key=_schema_rank)
     if errors:
-        raise _schema_error(jsonschema.exceptions.best_match(errors), doc, path)
+        first = errors[0]
+        raise _schema_error(jsonschema.exceptions.best_match([first]) if first.context else first, doc, path)
     backend = _world_backend(doc, path)
     from .tree_loader import check_tree
 
@@ -209,12 +264,13 @@ def load_scenario(path: str | Path) -> Scenario:
         line = doc["robots"].item_line(i)
         if r["name"] in names or r["name"] == "base":
             why = "is used twice" if r["name"] in names else "is reserved for the base station"
-            raise DelveError(f"robot name {r['name']!r} {why}", path, line)
+            raise DelveError(f"robot name {short_repr(r['name'])} {why}", path, line)
         names.add(r["name"])
         tree = (path.parent / r["tree"]).resolve()
         if not tree.exists():
-            raise DelveError(f"robot {r['name']!r}: tree file not found: {r['tree']}", path, r.key_line("tree"))
-        robot_types[r["name"]] = check_tree(tree)
+            raise DelveError(f"robot {short_repr(r['name'])}: tree file not found: {short_repr(r['tree'])[1:-1]}", path,
+                             r.key_line("tree"))
+        robot_types[r["name"]] = check_tree(tree, include_path=include_path)
         tree_types |= robot_types[r["name"]]
         extra = {k: float(r[k]) for k in ("speed_mps", "max_inclination_deg", "max_step_m") if k in r}
         robots.append(RobotSpec(name=r["name"], platform=r["platform"], tree=tree, start=r.get("start"),
@@ -227,8 +283,9 @@ def load_scenario(path: str | Path) -> Scenario:
     if "tree" in base:
         base_tree = (path.parent / base["tree"]).resolve()
         if not base_tree.exists():
-            raise DelveError(f"base station tree file not found: {base['tree']}", path, base.key_line("tree"))
-        tree_types |= check_tree(base_tree)
+            raise DelveError(f"base station tree file not found: {short_repr(base['tree'])[1:-1]}", path,
+                             base.key_line("tree"))
+        tree_types |= check_tree(base_tree, include_path=include_path)
     supervisor = load_supervisor(doc.get("supervisor"), path, {r.name: r.breadcrumbs for r in robots})
     faults = load_faults(doc.get("faults"), FaultContext(path, {r.name: r for r in robots}, robot_types, backend,
                                                          base_tree is not None))
@@ -244,4 +301,4 @@ def load_scenario(path: str | Path) -> Scenario:
                     world=plain(doc["world"]), robots=robots, base_tree=base_tree,
                     base_position=base.get("position"), base_tick_hz=float(base.get("tick_hz", 1.0)),
                     radio=plain(doc.get("radio", {})), doc=doc, world_backend=backend, team=team, supervisor=supervisor,
-                    faults=faults)
+                    faults=faults, include_path=include_path)

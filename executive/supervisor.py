@@ -12,6 +12,7 @@ from pathlib import Path
 from typing import Any
 
 from ..skills.operator import COMMANDS
+from ..skills.base import short_repr
 from .errors import DelveError, did_you_mean
 from .yamlio import YamlDict, YamlList, plain
 
@@ -49,20 +50,22 @@ def load_supervisor(items: Any, path: Path, robots: dict[str, int]) -> list[Comm
                 raise DelveError(f"supervisor command: {key!r} is missing", path, line)
         at = item["at_s"]
         if isinstance(at, bool) or not isinstance(at, (int, float)) or not at >= 0:
-            raise DelveError(f"supervisor command: at_s must be a time >= 0, got {at!r}", path, item.key_line("at_s"))
+            raise DelveError(f"supervisor command: at_s must be a time >= 0, got {short_repr(at)}", path,
+                             item.key_line("at_s"))
         robot, name = item["robot"], item["command"]
         if robot not in robots:
-            raise DelveError(f"supervisor command to unknown robot {robot!r}{did_you_mean(str(robot), robots)}",
+            raise DelveError(f"supervisor command to unknown robot {short_repr(robot)}"
+                             f"{did_you_mean(str(robot), robots)}",
                              path, item.key_line("robot"))
         if name not in COMMANDS:
-            raise DelveError(f"unknown supervisor command {name!r}{did_you_mean(str(name), COMMANDS)}", path,
+            raise DelveError(f"unknown supervisor command {short_repr(name)}{did_you_mean(str(name), COMMANDS)}", path,
                              item.key_line("command"))
         spec = COMMANDS[name]
         args = {k: v for k, v in item.items() if k not in RESERVED}
         for key in args:
             if key not in spec:
-                raise DelveError(f"command {name!r} has no argument {key!r}{did_you_mean(key, spec)}", path,
-                                 item.key_line(key))
+                raise DelveError(f"command {name!r} has no argument {short_repr(key)}{did_you_mean(str(key), spec)}",
+                                 path, item.key_line(key))
         for key, param in spec.items():
             if key not in args and param.required:
                 raise DelveError(f"command {name!r} needs {key!r} ({param.doc})", path, line)
@@ -73,7 +76,8 @@ def load_supervisor(items: Any, path: Path, robots: dict[str, int]) -> list[Comm
             if problem:
                 raise DelveError(f"command {name!r}: {key} {problem}", path, item.key_line(key) if key in args else line)
         if name == "drop_breadcrumb" and robots[robot] == 0:
-            raise DelveError(f"robot {robot!r} carries no breadcrumbs to drop (set its 'breadcrumbs')", path, line)
+            raise DelveError(f"robot {short_repr(robot)} carries no breadcrumbs to drop (set its 'breadcrumbs')", path,
+                             line)
         if name == "set_bbox" and any(lo > hi for lo, hi in zip(args["min"], args["max"])):
             raise DelveError("command 'set_bbox': min must not exceed max", path, line)
         out.append(Command(float(at), robot, name, plain(args)))

@@ -18,25 +18,36 @@ or an include of another file, its root renamed and blackboard keys remapped::
     name: Go home                         # optional
 
 Includes nest, remaps compose, and include cycles are reported with their chain.
+An include resolves (symbolic links followed) only inside the folder of the tree being
+loaded and its sub-folders, the shipped trees, and the folders the user names
+(``include_path``, the command line's ``--include-path``); anything else is refused
+before the file is opened. A tree nests at most :data:`MAX_TREE_DEPTH` nodes deep.
 Every mistake raises :class:`~delve.executive.errors.DelveError` with the file, line
-and node.
+and node; it quotes at most a few dozen characters of a value.
 """
 from __future__ import annotations
 
 import os
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from typing import Any
 
 from py_trees.behaviour import Behaviour
 
-from ..skills.base import AgentContext
-from .errors import DelveError, did_you_mean
+from .. import TREES_DIR
+from ..skills.base import AgentContext, short_repr
+from .errors import DelveError, did_you_mean, display_path
 from .registry import Build, NodeType, Registry, Site, coerce_param, default_registry
-from .yamlio import YamlDict, YamlList, line_of, load_yaml
+from .yamlio import YamlDict, YamlList, line_of, line_of_key_named, load_yaml
 
-__all__ = ["build_tree", "check_context", "check_tree", "compose_remap", "load_tree"]
+__all__ = ["MAX_TREE_DEPTH", "build_tree", "check_context", "check_tree", "compose_remap", "load_tree"]
 
 _INCLUDE_KEYS = ("include", "remap", "name")
+#: Deepest a tree may nest, nodes within nodes, includes counted (the shipped trees
+#: nest 9 deep); deeper trees are a mistake (a runaway generator) and would exhaust
+#: Python's stack when built, ticked or drawn.
+MAX_TREE_DEPTH = 100
+#: How much of a builder's own explanation an error repeats.
+_BUILD_ERROR_CHARS = 160
 
 
 def compose_remap(inner: Mapping[str, str] | None, outer: Mapping[str, str] | None) -> dict[str, str]:
@@ -48,6 +59,12 @@ def compose_remap(inner: Mapping[str, str] | None, outer: Mapping[str, str] | No
     return composed
 
 
+def _kind(value: Any) -> str:
+    if isinstance(value, list):
+        return "a list"
+    return "a string" if isinstance(value, str) else f"a value of type {type(value).__name__}"
+
+
 def _describe(value: Any) -> str:
     if value is None:
         return "null"
@@ -56,8 +73,29 @@ def _describe(value: Any) -> str:
     if isinstance(value, Mapping):
         return "a mapping"
     if isinstance(value, str):
-        return f"the string {value!r}"
-    return f"{type(value).__name__} {value!r}"
+        return f"the string {short_repr(value)}"
+    return f"{type(value).__name__} {short_repr(value)}"
+
+
+def _clip(text: str, limit: int = _BUILD_ERROR_CHARS) -> str:
+    text = " ".join(str(text).split())
+    return text if len(text) <= limit else text[:limit] + "..."
+
+
+def allowed_include_roots(tree_file: str | os.PathLike[str] | None,
+                          include_path: Iterable[str | os.PathLike[str]] = ()) -> tuple[str, ...]:
+    """The folders an include of the tree ``tree_file`` may resolve into, symbolic links
+    resolved: the tree's own folder, the shipped trees and ``include_path``."""
+    own = os.path.dirname(os.path.realpath(tree_file)) if tree_file is not None else os.getcwd()
+    roots = [own, os.path.realpath(TREES_DIR), *(os.path.realpath(p) for p in include_path)]
+    return tuple(dict.fromkeys(roots))
+
+
+def _inside(path: str, root: str) -> bool:
+    try:
+        return os.path.commonpath([path, root]) == root
+    except ValueError:  # another drive on Windows
+        return False
 
 
 class _ZeroClock:
@@ -72,10 +110,13 @@ def check_context() -> AgentContext:
 
 
 class _TreeBuilder:
-    def __init__(self, ctx: AgentContext, registry: Registry, root_file: str | None):
+    def __init__(self, ctx: AgentContext, registry: Registry, root_file: str | None,
+                 include_path: Iterable[str | os.PathLike[str]] = ()):
         self.ctx = ctx
         self.registry = registry
         self.root_dir = os.path.dirname(os.path.realpath(root_file)) if root_file else os.getcwd()
+        self.roots = allowed_include_roots(root_file, include_path)
+        self.depth = 0
 
     # ---------------------------------------------------------------- files
 
@@ -83,11 +124,32 @@ class _TreeBuilder:
         rel = os.path.relpath(real, self.root_dir)
         return real if rel.startswith(os.pardir) else rel
 
-    def file(self, path: str, remap: dict[str, str], chain: tuple[str, ...]) -> Behaviour:
+    def file(self, path: str, remap: dict[str, str], chain: tuple[str, ...], site: Site | None = None) -> Behaviour:
         data = load_yaml(path)
         if data is None:
             raise DelveError("empty tree file: its top-level mapping must be the root node", path, 1)
+        if not isinstance(data, Mapping):  # said without quoting it: this may be any text file
+            raise DelveError(f"a tree file's top level must be a mapping (the root node), not {_kind(data)}: "
+                             "is it a tree file?", path, line_of(data, 1))
+        self.not_a_scenario(data, path, site)
         return self.node(data, path, 1, remap, chain)
+
+    @staticmethod
+    def not_a_scenario(data: Any, path: str, site: Site | None) -> None:
+        """A DelveError when the tree file ``path`` holds a scenario (at the include
+        that names it, if any)."""
+        if not isinstance(data, Mapping) or "type" in data or "include" in data:
+            return
+        from .scenario import scenario_keys
+
+        keys = scenario_keys(data)
+        if not keys:
+            return
+        what = f"{os.path.basename(path)} is a scenario, not a tree (it has {', '.join(map(repr, keys[:3]))})"
+        if site is not None:
+            site.fail(f"include {short_repr(site.node['include'])}: {what}", "include")
+        line = data.key_line(keys[0]) if isinstance(data, YamlDict) else 1
+        raise DelveError(f"{what}: name a tree file, or validate or run the scenario", path, line)
 
     # ---------------------------------------------------------------- nodes
 
@@ -99,9 +161,17 @@ class _TreeBuilder:
                 line_of(data, line),
             )
         line = line_of(data, line)
-        if "include" in data:
-            return self.include(data, file, line, remap, chain)
-        return self.typed(data, file, line, remap, chain)
+        self.depth += 1
+        try:
+            if self.depth > MAX_TREE_DEPTH:
+                name = data.get("name")
+                raise DelveError(f"the tree nests more than {MAX_TREE_DEPTH} nodes deep (includes counted)", file, line,
+                                 name if isinstance(name, str) else None)
+            if "include" in data:
+                return self.include(data, file, line, remap, chain)
+            return self.typed(data, file, line, remap, chain)
+        finally:
+            self.depth -= 1
 
     def include(self, data: Mapping[str, Any], file: str | None, line: int | None, remap: dict[str, str], chain: tuple[str, ...]) -> Behaviour:
         site = Site(file, data, None, line)
@@ -114,7 +184,7 @@ class _TreeBuilder:
                 hint = did_you_mean(str(key), _INCLUDE_KEYS)
                 if key == "type":
                     hint = " (a node is either an include or a typed node, not both)"
-                site.fail(f"unknown key {key!r} in an include{hint}", key)
+                site.fail(f"unknown key {short_repr(key)} in an include{hint}", key)
         target = data["include"]
         if not isinstance(target, str) or not target:
             site.fail(f"'include' must be a path (a string), not {_describe(target)}", "include")
@@ -125,7 +195,7 @@ class _TreeBuilder:
             if not isinstance(key, str) or not key or not isinstance(value, str) or not value:
                 line_hint = inner.key_line(key) if isinstance(inner, YamlDict) else None
                 raise DelveError(
-                    f"remap entries must map a key name to a key name, not {key!r}: {value!r}",
+                    f"remap entries must map a key name to a key name, not {short_repr(key)}: {short_repr(value)}",
                     file,
                     line_hint or site.line_of("remap"),
                     name,
@@ -133,13 +203,20 @@ class _TreeBuilder:
         base = os.path.dirname(file) if file else ""
         path = os.path.normpath(os.path.join(base, target))
         real = os.path.realpath(path)
+        if not any(_inside(real, root) for root in self.roots):
+            folders = ", ".join([f"the tree's folder {os.path.join(display_path(self.roots[0]), '')}",
+                                 "the shipped trees", *(display_path(r) for r in self.roots[2:])])
+            site.fail(f"include {short_repr(target)} is outside the allowed folders ({folders}; add --include-path)",
+                      "include")
         if real in chain:
             names = [self.chain_name(p) for p in chain[chain.index(real):]] + [self.chain_name(real)]
             site.fail(f"include cycle: {' -> '.join(names)}", "include")
         if not os.path.isfile(path):
-            what = "is a directory" if os.path.isdir(path) else "not found"
-            site.fail(f"included file {what}: {target!r} (looked for {path})", "include")
-        root = self.file(path, compose_remap(inner, remap), (*chain, real))
+            what = "is a directory" if os.path.isdir(path) else "is not a regular file" if os.path.exists(path) else \
+                "not found"
+            site.fail(f"included file {what}: {short_repr(target)} (relative to {display_path(base or '.')})",
+                      "include")
+        root = self.file(path, compose_remap(inner, remap), (*chain, real), site)
         if name is not None:
             root.name = name
         return root
@@ -151,14 +228,14 @@ class _TreeBuilder:
             site.node_name = explicit_name
         if "type" not in data:
             close = [k for k in data if isinstance(k, str) and did_you_mean(k, ("type", "include"))]
-            hint = f" ({close[0]!r} is not 'type' or 'include')" if close else ""
+            hint = f" ({short_repr(close[0])} is not 'type' or 'include')" if close else ""
             site.fail(f"node has no 'type' (or 'include'){hint}")
         type_name = data["type"]
         if not isinstance(type_name, str):
             site.fail(f"'type' must be a string, not {_describe(type_name)}", "type")
         node_type = self.registry.get(type_name)
         if node_type is None:
-            site.fail(f"unknown behaviour type {type_name!r}{self.registry.suggest(type_name)}", "type")
+            site.fail(f"unknown behaviour type {short_repr(type_name)}{self.registry.suggest(type_name)}", "type")
         if explicit_name is not None and (not isinstance(explicit_name, str) or not explicit_name):
             site.fail(f"'name' must be a non-empty string, not {_describe(explicit_name)}", "name")
         name = explicit_name or type_name
@@ -187,7 +264,8 @@ class _TreeBuilder:
         except DelveError:
             raise
         except ValueError as err:
-            site.fail(f"cannot build {type_name!r}: {err}")
+            raise DelveError(f"cannot build {type_name!r}: {_clip(err)}", file,
+                             line_of_key_named(data, str(err)) or site.line, site.node_name) from None
 
     def params(self, node_type: NodeType, data: Mapping[str, Any], site: Site) -> tuple[dict[str, Any], list[str]]:
         structural = {"type", "name", *node_type.subtrees}
@@ -201,7 +279,8 @@ class _TreeBuilder:
         for key in given:
             if key not in node_type.params:
                 known = [*node_type.params, *sorted(structural - {"type"})]
-                site.fail(f"unknown parameter {key!r} for {node_type.name!r}{did_you_mean(str(key), known)}", key)
+                site.fail(f"unknown parameter {short_repr(key)} for {node_type.name!r}{did_you_mean(str(key), known)}",
+                          key)
         values: dict[str, Any] = {}
         missing = []
         for pname, spec in node_type.params.items():
@@ -258,11 +337,13 @@ def build_tree(
     file: str | os.PathLike[str] | None = None,
     remap: Mapping[str, str] | None = None,
     registry: Registry | None = None,
+    include_path: Iterable[str | os.PathLike[str]] = (),
 ) -> Behaviour:
     """Build the tree whose root node is ``data`` (already parsed, e.g. a tree written
-    inline in a scenario); includes resolve relative to ``file``'s directory."""
+    inline in a scenario); includes resolve relative to ``file``'s directory, and
+    inside it, the shipped trees or ``include_path``."""
     file_text = os.fspath(file) if file is not None else None
-    builder = _TreeBuilder(ctx, registry or default_registry(), file_text)
+    builder = _TreeBuilder(ctx, registry or default_registry(), file_text, include_path)
     chain = (os.path.realpath(file_text),) if file_text else ()
     return builder.node(data, file_text, line_of(data, 1), dict(remap or {}), chain)
 
@@ -273,16 +354,19 @@ def load_tree(
     *,
     remap: Mapping[str, str] | None = None,
     registry: Registry | None = None,
+    include_path: Iterable[str | os.PathLike[str]] = (),
 ) -> Behaviour:
     """Build the py_trees tree of the YAML file at ``path`` for the agent ``ctx``.
 
     ``remap`` renames blackboard keys of the whole tree (as an include's remap does).
+    Includes may resolve inside the tree's folder, the shipped trees and the folders
+    of ``include_path``.
 
     Raises:
         DelveError: any mistake in the file or the files it includes.
     """
     file_text = os.fspath(path)
-    builder = _TreeBuilder(ctx, registry or default_registry(), file_text)
+    builder = _TreeBuilder(ctx, registry or default_registry(), file_text, include_path)
     return builder.file(file_text, dict(remap or {}), (os.path.realpath(file_text),))
 
 
@@ -302,13 +386,14 @@ def _release_blackboard(root: Behaviour) -> None:
                 pass
 
 
-def check_tree(path: str | os.PathLike[str], *, registry: Registry | None = None) -> set[type]:
+def check_tree(path: str | os.PathLike[str], *, registry: Registry | None = None,
+               include_path: Iterable[str | os.PathLike[str]] = ()) -> set[type]:
     """Check the YAML tree at ``path`` by building it for a dummy agent; return the
     classes of its nodes.
 
     Raises:
         DelveError: the first mistake found, with its file, line and node.
     """
-    root = load_tree(path, check_context(), registry=registry)
+    root = load_tree(path, check_context(), registry=registry, include_path=include_path)
     _release_blackboard(root)
     return {type(node) for node in root.iterate()}

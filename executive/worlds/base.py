@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Any, ClassVar, Mapping
 
 import numpy as np
 
+from ...skills.base import short_repr
 from ..errors import DelveError, did_you_mean
 from ..yamlio import YamlDict
 
@@ -145,4 +146,4 @@ def only_keys(mapping: YamlDict, allowed: tuple[str, ...], what: str, path: Path
     """A :class:`DelveError` at the first key of ``mapping`` not in ``allowed``."""
     for key in mapping:
         if key not in allowed:
-            raise DelveError(f"{what} {key!r}{did_you_mean(key, allowed)}", path, mapping.key_line(key))
+            raise DelveError(f"{what} {short_repr(key)}{did_you_mean(str(key), allowed)}", path, mapping.key_line(key))

@@ -14,9 +14,9 @@ from ...sim.graph_radio import GraphRadioNetwork, GraphRadioSpec
 from ...sim.graph_robot import GraphRobot
 from ...sim.graph_world import GraphWorld
 from ...sim.platforms import PLATFORMS
-from ...skills.base import AgentContext
+from ...skills.base import AgentContext, short_repr
 from ..errors import DelveError
-from ..yamlio import YamlDict
+from ..yamlio import YamlDict, line_of_key_named
 from . import graph_sources
 from .base import BASE, Coverage, TeamNetwork, WorldBackend, only_keys
 from .graph_plot import plot_graph_map
@@ -55,7 +55,8 @@ class GraphBackend(WorldBackend):
             only_keys(world, ("network",), "world: unknown parameter", path)
             net_path = path.parent / world["network"]
             if not net_path.exists():
-                raise DelveError(f"network file not found: {world['network']}", path, world.key_line("network"))
+                raise DelveError(f"network file not found: {short_repr(world['network'])[1:-1]}", path,
+                                 world.key_line("network"))
             graph_sources.load_network_world(net_path)
         super().check(doc, path, has_base_tree)
         if not has_base_tree:
@@ -63,8 +64,8 @@ class GraphBackend(WorldBackend):
                              path, doc.key_line("base_station") or doc.key_line("world"))
         for key in doc.get("radio", {}):
             if key not in RADIO_KEYS:
-                raise DelveError(f"radio: {key!r} does not apply to a graph world (communication edges decide "
-                                 f"links; use {', '.join(RADIO_KEYS)})", path, doc["radio"].key_line(key))
+                raise DelveError(f"radio: {short_repr(key)} does not apply to a graph world (communication edges "
+                                 f"decide links; use {', '.join(RADIO_KEYS)})", path, doc["radio"].key_line(key))
 
     @classmethod
     def build_world(cls, scenario: "Scenario", seed: int) -> GraphWorld:
@@ -76,7 +77,8 @@ class GraphBackend(WorldBackend):
             spec.setdefault("seed", seed)
             return generate(**spec)
         except ValueError as err:
-            raise DelveError(f"world: {err}", scenario.path, scenario.doc["world"].line) from None
+            where = scenario.doc["world"]
+            raise DelveError(f"world: {err}", scenario.path, line_of_key_named(where, str(err)) or where.line) from None
 
     # ---- a mission ----------------------------------------------------------------
     def __init__(self, scenario: "Scenario", world: GraphWorld, seed: int, clock: SimClock):

@@ -20,7 +20,7 @@ from ...skills.base import AgentContext
 from ...skills.cops.voxel_view import VoxelNetworkView
 from ...skills.navigation import navigator
 from ..errors import DelveError
-from ..yamlio import YamlDict
+from ..yamlio import YamlDict, line_of_key_named
 from .base import BASE, Coverage, TeamNetwork, WorldBackend, only_keys
 from .voxel_plot import plot_voxel_map
 
@@ -72,7 +72,7 @@ class VoxelBackend(WorldBackend):
             spec.setdefault("seed", seed)
             return generate(**spec)
         except ValueError as err:
-            raise DelveError(f"world: {err}", scenario.path, where.line) from None
+            raise DelveError(f"world: {err}", scenario.path, line_of_key_named(where, str(err)) or where.line) from None
 
     # ---- a mission ----------------------------------------------------------------
     def __init__(self, scenario: "Scenario", world: World, seed: int, clock: SimClock):

@@ -228,7 +228,7 @@ def test_value_error_in_a_skill_constructor_is_a_delve_error(tmp_path):
     path = write(tmp_path, "t.yaml", "type: Sequence\nchildren:\n  - type: Success\n  - type: Fragile\n    name: Far\n    range_m: 500\n")
     with pytest.raises(DelveError) as info:
         check_tree(path, registry=fragile_registry())
-    assert info.value.line == 4 and info.value.node == "Far"
+    assert info.value.line == 6 and info.value.node == "Far"  # the key the error names
     assert "range_m beyond the sensor's 100 m" in str(info.value)
 
 
