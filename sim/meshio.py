@@ -12,9 +12,13 @@ crossings are left as rock.
 
 from __future__ import annotations
 
+import contextlib
+import ctypes
 import math
+import os
+import sys
 from pathlib import Path
-from typing import Sequence
+from typing import Iterator, Sequence
 
 import networkx as nx
 import numpy as np
@@ -50,14 +54,55 @@ def up_axis_rotation(up_axis: str) -> np.ndarray:
     return UP_AXIS_ROTATIONS[key]
 
 
+@contextlib.contextmanager
+def native_output_silenced() -> Iterator[None]:
+    """Silence what native code prints to the process's stdout and stderr (Open3D's
+    warnings, the RPly reader's complaints about a broken PLY), so that a broken mesh
+    gives delve's one line and nothing before it. Python's own streams are flushed
+    first and the C library's before the descriptors are restored."""
+    previous = o3d.utility.get_verbosity_level()
+    o3d.utility.set_verbosity_level(o3d.utility.VerbosityLevel.Error)
+    saved: list[tuple[int, int]] = []
+    try:
+        for stream in (sys.stdout, sys.stderr):
+            try:
+                stream.flush()
+            except (AttributeError, ValueError, OSError):
+                pass
+        with open(os.devnull, "wb") as devnull:
+            for fd in (1, 2):
+                try:
+                    saved.append((fd, os.dup(fd)))
+                    os.dup2(devnull.fileno(), fd)
+                except OSError:
+                    pass
+            yield
+    finally:
+        _flush_c_stdio()
+        for fd, copy in saved:
+            os.dup2(copy, fd)
+            os.close(copy)
+        o3d.utility.set_verbosity_level(previous)
+
+
+def _flush_c_stdio() -> None:
+    try:
+        ctypes.CDLL(None).fflush(None)
+    except (OSError, AttributeError):
+        pass
+
+
 def read_mesh(path: str | Path) -> o3d.geometry.TriangleMesh:
-    """Read a PLY / OBJ / STL mesh; ValueError "cannot read mesh 'path'" if absent or empty."""
+    """Read a PLY / OBJ / STL mesh; ValueError "cannot read mesh 'path'" if absent,
+    unreadable or without triangles. What the native readers print is silenced."""
     path = Path(path)
     if not path.is_file() or path.suffix.lower() not in MESH_SUFFIXES:
-        raise ValueError(f"cannot read mesh '{path}'")
-    mesh = o3d.io.read_triangle_mesh(str(path), print_progress=False)
+        raise ValueError(f"cannot read mesh '{path.name}'")
+    with native_output_silenced():
+        mesh = o3d.io.read_triangle_mesh(str(path), print_progress=False)
     if len(mesh.triangles) == 0 or len(mesh.vertices) == 0:
-        raise ValueError(f"cannot read mesh '{path}'")
+        raise ValueError(f"cannot read mesh '{path.name}': no triangles in it (a broken or empty "
+                         f"{path.suffix.lstrip('.').upper()} file?)")
     return mesh
 
 
