@@ -127,6 +127,8 @@ def run(path: Path, out: Path | None, seed: int | None, duration_s: float | None
           f"at base {rep['base_coverage_fraction']:.1%}")
     for reason in rep["outcome"]["reasons"]:
         print(f"  why: {reason}")
+    for note in rep["outcome"]["notes"]:
+        print(f"  note: {note}")
     lost = rep["outcome"]["lost"]
     for r in rep["robots"]:
         state = f"lost ({lost[r['name']]})" if r["name"] in lost else r["final_status"]

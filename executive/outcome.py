@@ -14,8 +14,11 @@ A mission succeeded when
 
 Each rule that fails adds one line to :attr:`Outcome.reasons`; each tree that did not
 end in SUCCESS adds the node it failed at and the failure its behaviours logged
-(``explore_failed``, ``homing_failed``, ...). ``delve run`` prints them, and
-``report.json`` holds them under ``outcome``.
+(``explore_failed``, ``homing_failed``, ...). A tree that ended in SUCCESS although
+its exploration ended in a failure (the planner raised, say, and the tree went home)
+adds a line to :attr:`Outcome.notes`: the mission still succeeded, for a reason the
+console shows. ``delve run`` prints both, and ``report.json`` holds them under
+``outcome``.
 """
 from __future__ import annotations
 
@@ -37,6 +40,8 @@ MIN_PROGRESS_FRACTION = 0.02
 MUCH_LEFT_FRACTION = 0.10
 #: Events in which behaviours say why they failed (besides every ``*_failed``).
 FAILURE_EVENTS = ("cops_no_plan", "cops_invalid_plan", "return_without_plan")
+#: Events that end a robot's exploration, well or not.
+EXPLORATION_ENDS = ("explore_failed", "exploration_complete", "planner_homing", "endurance_low", "homing_timer")
 
 
 @dataclass(frozen=True)
@@ -49,9 +54,11 @@ class Outcome:
     timed_out: bool
     reasons: tuple[str, ...] = ()
     lost: dict[str, str] = field(default_factory=dict)
+    notes: tuple[str, ...] = ()
 
     def to_dict(self) -> dict[str, Any]:
-        return {"timed_out": self.timed_out, "reasons": list(self.reasons), "lost": dict(self.lost)}
+        return {"timed_out": self.timed_out, "reasons": list(self.reasons), "notes": list(self.notes),
+                "lost": dict(self.lost)}
 
 
 def failing_node(root: py_trees.behaviour.Behaviour) -> py_trees.behaviour.Behaviour:
@@ -87,6 +94,13 @@ def _last_word(events: list[dict[str, Any]], agent: str) -> str | None:
     return None
 
 
+def exploration_failure(events: list[dict[str, Any]], agent: str) -> str | None:
+    """The failure an agent's exploration ended with, when its last exploration end
+    (:data:`EXPLORATION_ENDS`) was one; else None."""
+    last = next((e for e in reversed(events) if e.get("agent") == agent and e["event"] in EXPLORATION_ENDS), None)
+    return failure_event([last], agent) if last is not None and last["event"] == "explore_failed" else None
+
+
 def agent_reason(mission: "Mission", agent: "Agent", timed_out: bool) -> str:
     """One line: why ``agent``'s tree did not end in SUCCESS."""
     status = agent.root.status
@@ -98,7 +112,7 @@ def agent_reason(mission: "Mission", agent: "Agent", timed_out: bool) -> str:
                 + (f": {why}" if why else ""))
     when = (f"when the run stopped at its duration ({mission.duration_s:g} s)" if timed_out
             else "when the mission ended")
-    return f"{agent.name}: still {status.value} {when}"
+    return f"{agent.name}: had not finished {when}"
 
 
 def mission_outcome(mission: "Mission") -> Outcome:
@@ -124,4 +138,10 @@ def mission_outcome(mission: "Mission") -> Outcome:
         if end - start < MIN_PROGRESS_FRACTION and 1.0 - start >= MUCH_LEFT_FRACTION:
             reasons.append(f"the team explored {max(end - start, 0.0):.1%} of the world beyond what it saw at its "
                            f"start (at least {MIN_PROGRESS_FRACTION:.0%} expected, {1.0 - start:.0%} was unexplored)")
-    return Outcome(succeeded=not reasons, timed_out=timed_out, reasons=tuple(reasons), lost=dict(mission.lost))
+    notes = []
+    for agent in mission.robot_agents:
+        failure = exploration_failure(mission.state.events, agent.name)
+        if agent.root.status == Status.SUCCESS and failure:
+            notes.append(f"{agent.name}: SUCCESS, but its exploration ended with {failure}")
+    return Outcome(succeeded=not reasons, timed_out=timed_out, reasons=tuple(reasons), lost=dict(mission.lost),
+                   notes=tuple(notes))

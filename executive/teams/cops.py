@@ -85,14 +85,22 @@ class Cops(TeamStrategy):
             self._leader = _cops_skill(mission.agents[BASE].root)
 
     def robot_figures(self, mission: "Mission", name: str) -> dict[str, Any]:
-        """``locations_undelivered``: locations the robot knows explored that the base
-        station does not (what a lost robot took with it). Graph-world radios drop
-        datagrams, so its ``messages_undelivered`` stays 0; a COPS team shares
-        locations, not maps, so no ``map_voxels_undelivered``."""
+        """What the robot holds that never reached the base station (what a lost robot
+        took with it): ``locations_undelivered``, locations it knows explored that the
+        base station does not, and on voxel worlds ``map_chunks_undelivered``, the
+        pieces of its own map the base station's knowledge lacks, besides
+        ``map_voxels_undelivered``. Graph-world radios drop datagrams (COPS sends
+        again until acknowledged), so ``messages_undelivered`` stays 0 there."""
         skill = _cops_skill(mission.agents[name].root)
         st = skill.stored_state() if skill is not None else None
+        base = self.base_state()
         held = set(st.knowledge.topology.explored) if st is not None else set()
-        return {"locations_undelivered": len(held - self.explored_at_base())}
+        figures = {**super().robot_figures(mission, name),
+                   "locations_undelivered": len(held - self.explored_at_base())}
+        if mission.backend.map_undelivered(name) is not None:
+            own = {k for k in (st.knowledge.map_chunks if st is not None else {}) if k.startswith(f"{name}/")}
+            figures["map_chunks_undelivered"] = len(own - set(base.knowledge.map_chunks if base is not None else ()))
+        return figures
 
     def explored_at_base(self) -> set[str]:
         st = self.base_state()

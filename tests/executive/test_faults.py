@@ -128,3 +128,9 @@ def test_a_registered_kind_can_be_used_by_a_scenario(tmp_path):
 
 def test_kinds_that_cannot_end_take_no_duration():
     assert FAULT_KINDS["lost"].DURATION == NEVER and FAULT_KINDS["stuck"].DURATION == "required"
+
+
+def test_the_docs_list_every_kind():
+    table = (Path(__file__).parent.parent.parent / "docs" / "scenarios.md").read_text()
+    for name in FAULT_KINDS:
+        assert f"| `{name}` |" in table, name
