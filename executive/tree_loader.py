@@ -263,7 +263,7 @@ class _TreeBuilder:
             return node_type.build(build)
         except DelveError:
             raise
-        except ValueError as err:
+        except (ValueError, TypeError) as err:  # the builder refused the checked parameters
             raise DelveError(f"cannot build {type_name!r}: {_clip(err)}", file,
                              line_of_key_named(data, str(err)) or site.line, site.node_name) from None
 

@@ -62,8 +62,8 @@ def yaml_number_hint(value: Any, integer: bool = False) -> str:
         number = float(text)
     except ValueError:
         return ""
-    if not math.isfinite(number):
-        return ""
+    if not math.isfinite(number) or (number == 0 and re.search(r"[1-9]", text.lower().partition("e")[0])):
+        return ""  # beyond a float's range
     if isinstance(yaml.safe_load(text), (int, float)):
         return " (a number in quotes is a string: write it without quotes)"
     forms = []

@@ -23,6 +23,7 @@ and gamma_H = 5 for the hanging vertices, mu_V = 50 m for the local point cloud.
 from __future__ import annotations
 
 import math
+import reprlib
 from dataclasses import asdict, dataclass, fields, replace
 from typing import Any
 
@@ -165,7 +166,7 @@ class GBPlannerConfig:
             value = getattr(self, name)
             if isinstance(value, list):
                 object.__setattr__(self, name, tuple(value))
-        problems = _problems(self)
+        problems = _type_problems(self) or _problems(self)
         if problems:
             raise ValueError("invalid GBPlannerConfig: " + "; ".join(problems))
 
@@ -242,7 +243,33 @@ class GBPlannerConfig:
 def _check_names(values: dict[str, Any]) -> None:
     unknown = set(values) - {f.name for f in fields(GBPlannerConfig)}
     if unknown:
-        raise ValueError(f"unknown GBPlannerConfig parameter(s): {', '.join(sorted(unknown))}")
+        raise ValueError(f"unknown GBPlannerConfig parameter(s): {', '.join(sorted(map(str, unknown)))}")
+
+
+def _is_number(value: Any) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
+#: What a field's annotation asks of its value, and how a message says it.
+_FIELD_TYPES = {
+    "bool": (lambda v: isinstance(v, bool), "true or false"),
+    "int": (lambda v: isinstance(v, int) and not isinstance(v, bool), "an integer"),
+    "float": (_is_number, "a number"),
+    "str": (lambda v: isinstance(v, str), "a string"),
+    "tuple[float, float, float]": (lambda v: isinstance(v, (tuple, list)) and len(v) == 3 and all(map(_is_number, v)),
+                                   "three numbers"),
+}
+
+
+def _type_problems(c: GBPlannerConfig) -> list[str]:
+    """Values of the wrong type (from YAML overrides), before the checks compare them."""
+    out = []
+    for f in fields(c):
+        check, words = _FIELD_TYPES.get(str(f.type), (None, ""))
+        value = getattr(c, f.name)
+        if check is not None and not check(value):
+            out.append(f"{f.name} must be {words}, got {reprlib.repr(value)}")
+    return out
 
 
 def _problems(c: GBPlannerConfig) -> list[str]:
