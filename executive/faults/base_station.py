@@ -4,14 +4,15 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 from ..errors import DelveError
-from .base import BASE_STATION, OPTIONAL, Fault, FaultContext, Target
+from .base import BASE_STATION, OPTIONAL, FaultContext, Target
+from .radio import RadioHold
 
 if TYPE_CHECKING:
     from ..runner import Mission
     from ..yamlio import YamlDict
 
 
-class BaseRestart(Fault):
+class BaseRestart(RadioHold):
     """The base station's executive restarts: its tree stops and is built afresh
     from its file, its blackboard is cleared, and the messages in its radio's inbox
     and outbox are lost. Its services outlive the restart: the base map (kept on
@@ -33,17 +34,14 @@ class BaseRestart(Fault):
     def end_s(self) -> float | None:
         return None if not self.duration_s else self.at_s + self.duration_s
 
+    def radios_down(self) -> set[str]:
+        from ..worlds import BASE
+
+        return {BASE} if self.duration_s else set()
+
     def start(self, mission: "Mission") -> dict[str, Any]:
         from ..worlds import BASE
 
-        down = self.duration_s or 0.0
-        lost = mission.restart_agent(BASE, resume_s=mission.clock.now_s + down)
-        if down:
-            mission.radio.endpoints[BASE].blackout = True
+        lost = mission.restart_agent(BASE, resume_s=mission.clock.now_s + (self.duration_s or 0.0))
+        self.apply(mission)
         return {"messages_lost": lost}
-
-    def end(self, mission: "Mission") -> dict[str, Any]:
-        from ..worlds import BASE
-
-        mission.radio.endpoints[BASE].blackout = False
-        return {}

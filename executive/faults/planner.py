@@ -2,8 +2,8 @@
 
 The seam is the agent's planner service (``ctx.services["gbplanner"]``, the one
 GBPlanner2 that ``ExploreGBPlanner2``, ``Home``, ``GoTo`` and ``Relocate`` of a robot
-share): the fault wraps that planner's ``plan`` while it lasts. Skills see a planner
-that raises (``ExploreGBPlanner2`` logs ``explore_failed`` with the error and fails)
+share): the fault wraps that planner's ``plan`` (a wrapper that passes the call through once
+the fault has ended, so that overlapping faults nest). Skills see a planner that raises (``ExploreGBPlanner2`` logs ``explore_failed`` with the error and fails)
 or a plan that arrives late (the robot stands while the planner "thinks"), and never
 learn that a simulator exists. The service is made by the robot's first plan; a
 fault that starts before it takes hold as soon as it exists.
@@ -35,6 +35,7 @@ class _PlannerFault(Fault):
     def __init__(self, *args: Any, **kwargs: Any):
         super().__init__(*args, **kwargs)
         self._planner: Any = None
+        self.holds = False
         self.hits = 0
 
     @classmethod
@@ -52,8 +53,10 @@ class _PlannerFault(Fault):
             return
         svc = mission.agents[self.robot].ctx.services.get(SERVICE)
         if svc is not None:
-            self._planner = svc.planner
-            self._planner.plan = self._wrap(type(self._planner).plan.__get__(self._planner), mission)
+            self._planner, self.holds = svc.planner, True
+            inner = self._planner.plan
+            faulty = self._wrap(inner, mission)
+            self._planner.plan = lambda *args, **kwargs: (faulty if self.holds else inner)(*args, **kwargs)
 
     def _hit(self) -> None:
         """Count a plan the fault hit; a fault without an end lets go after the first."""
@@ -62,9 +65,8 @@ class _PlannerFault(Fault):
             self._release()
 
     def _release(self) -> None:
-        if self._planner is not None and "plan" in vars(self._planner):
-            del self._planner.plan
-        self._planner = None
+        """From now on the wrapper passes every call through."""
+        self.holds = False
 
     def end(self, mission: "Mission") -> dict[str, Any]:
         self._release()

@@ -12,7 +12,38 @@ if TYPE_CHECKING:
     from ..yamlio import YamlDict
 
 
-class RadioBlackout(Fault):
+class RadioHold(Fault):
+    """A fault that holds radios off the air or links cut while it lasts. Overlapping
+    faults add up: a radio is back when no active fault holds it any more."""
+
+    def radios_down(self) -> set[str]:
+        """Radios (agent names, ``base``) this fault holds off the air."""
+        return set()
+
+    def links_cut(self) -> set[tuple[str, str]]:
+        """Links (sorted pairs of agent names) this fault holds cut."""
+        return set()
+
+    @staticmethod
+    def apply(mission: "Mission") -> None:
+        """Set every radio's blackout and the cut links from the active faults."""
+        holds = mission.faults.holding(RadioHold)
+        down = set().union(*(f.radios_down() for f in holds))
+        for name, endpoint in mission.radio.endpoints.items():
+            endpoint.blackout = name in down
+        mission.radio.cut_links.clear()
+        mission.radio.cut_links.update(*(f.links_cut() for f in holds))
+
+    def start(self, mission: "Mission") -> dict[str, Any]:
+        self.apply(mission)
+        return {}
+
+    def end(self, mission: "Mission") -> dict[str, Any]:
+        self.apply(mission)
+        return {}
+
+
+class RadioBlackout(RadioHold):
     """A radio goes off the air: one robot's (``robot``), the base station's
     (``base_station: true``), or one link between two agents (``link: [a, b]``, where
     ``base`` is the base station; routes through other radios still work). Messages
@@ -23,24 +54,15 @@ class RadioBlackout(Fault):
     TARGETS = (ROBOT, LINK, BASE_STATION)
     DURATION = OPTIONAL
 
-    def _set(self, mission: "Mission", down: bool) -> None:
+    def radios_down(self) -> set[str]:
         from ..worlds import BASE
 
-        radio = mission.radio
         if self.target.kind == LINK:
-            pair = tuple(sorted(self.target.names))
-            (radio.cut_links.add if down else radio.cut_links.discard)(pair)
-        else:
-            name = BASE if self.target.kind == BASE_STATION else self.target.names[0]
-            radio.endpoints[name].blackout = down
+            return set()
+        return {BASE if self.target.kind == BASE_STATION else self.target.names[0]}
 
-    def start(self, mission: "Mission") -> dict[str, Any]:
-        self._set(mission, True)
-        return {}
-
-    def end(self, mission: "Mission") -> dict[str, Any]:
-        self._set(mission, False)
-        return {}
+    def links_cut(self) -> set[tuple[str, str]]:
+        return {tuple(sorted(self.target.names))} if self.target.kind == LINK else set()
 
 
 class BreadcrumbDies(Fault):

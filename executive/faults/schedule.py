@@ -17,7 +17,9 @@ class FaultSchedule:
     """The faults of a mission: pending ones by time, active ones until they end.
 
     Each update starts the faults that are due (a ``fault`` event), ends those whose
-    ``end_s`` has come (a ``fault_end`` event) and steps the others. A fault aimed at
+    ``end_s`` has come (a ``fault_end`` event) and steps the others. A fault is in
+    ``active`` while it starts and lasts, and no longer when it ends, so that faults
+    of a kind that overlap can work out what the others still hold. A fault aimed at
     a robot that is already lost does not start (its ``fault`` event says so)."""
 
     def __init__(self, faults: list[Fault]):
@@ -30,9 +32,9 @@ class FaultSchedule:
             if fault.robot is not None and fault.robot in mission.lost:
                 mission.log("fault", **fault.fields(), skipped=f"robot {fault.robot} is lost")
                 continue
+            self.active.append(fault)
             extra = fault.start(mission) or {}
             mission.log("fault", **fault.fields(), **extra)
-            self.active.append(fault)
         for fault in list(self.active):
             end = fault.end_s
             if end is not None and end <= now_s + EPS_S:
@@ -41,3 +43,7 @@ class FaultSchedule:
                 mission.log("fault_end", **fault.fields(), **extra)
             else:
                 fault.step(mission, now_s)
+
+    def holding(self, kind: type[Fault], robot: str | None = None) -> list[Fault]:
+        """The active faults of ``kind`` (and its subclasses), on ``robot`` if given."""
+        return [f for f in self.active if isinstance(f, kind) and (robot is None or f.robot == robot)]

@@ -43,12 +43,27 @@ class LidarDegraded(Fault):
     }
     WORLDS = ("voxel",)
 
+    def degradation(self) -> tuple[float | None, float]:
+        """The range and the share of beams this fault leaves."""
+        return self.p["range_m"], self.p["ray_fraction"]
+
+    def _apply(self, mission: "Mission") -> None:
+        """Degrade the sensors as the active faults on the robot add up (the shortest
+        range, the smallest share), or restore them when none is left."""
+        robot = mission.robots[self.robot]
+        held = [f.degradation() for f in mission.faults.holding(LidarDegraded, self.robot)]
+        if not held:
+            robot.restore_lidar()
+            return
+        ranges = [r for r, _ in held if r is not None]
+        robot.degrade_lidar(min(ranges) if ranges else None, min(share for _, share in held))
+
     def start(self, mission: "Mission") -> dict[str, Any]:
-        mission.robots[self.robot].degrade_lidar(self.p["range_m"], self.p["ray_fraction"])
+        self._apply(mission)
         return {}
 
     def end(self, mission: "Mission") -> dict[str, Any]:
-        mission.robots[self.robot].restore_lidar()
+        self._apply(mission)
         return {}
 
 
@@ -59,9 +74,8 @@ class LidarDropout(LidarDegraded):
     KIND = "lidar_dropout"
     PARAMS = {}
 
-    def start(self, mission: "Mission") -> dict[str, Any]:
-        mission.robots[self.robot].degrade_lidar(None, 0.0)
-        return {}
+    def degradation(self) -> tuple[float | None, float]:
+        return None, 0.0
 
 
 class LocalisationDrift(Fault):
@@ -69,7 +83,8 @@ class LocalisationDrift(Fault):
     of motion, towards ``heading_deg`` (0: +x, 90: +y): it follows paths and
     integrates scans at the drifted pose, so its map smears and its paths may run
     into rock. At ``duration_s`` it relocalises (the drift goes; the map keeps what it
-    integrated); without it the drift grows to the end of the run."""
+    integrated); without it the drift grows to the end of the run. Overlapping drifts
+    add up."""
 
     KIND = "localisation_drift"
     DURATION = OPTIONAL
@@ -80,13 +95,22 @@ class LocalisationDrift(Fault):
     }
     WORLDS = ("voxel",)
 
-    def start(self, mission: "Mission") -> dict[str, Any]:
+    def velocity(self) -> np.ndarray:
+        """The drift's velocity (m per second of motion)."""
         a = math.radians(self.p["heading_deg"])
-        mission.robots[self.robot].drift(self.p["rate_mps"] * np.array([math.cos(a), math.sin(a), 0.0]))
+        return self.p["rate_mps"] * np.array([math.cos(a), math.sin(a), 0.0])
+
+    def _apply(self, mission: "Mission") -> None:
+        mission.robots[self.robot].drift(sum((f.velocity() for f in mission.faults.holding(LocalisationDrift,
+                                                                                            self.robot)), np.zeros(3)))
+
+    def start(self, mission: "Mission") -> dict[str, Any]:
+        self._apply(mission)
         return {}
 
     def end(self, mission: "Mission") -> dict[str, Any]:
         robot = mission.robots[self.robot]
         drift = robot.drift_m
         robot.relocalise()
+        self._apply(mission)
         return {"drift_m": round(drift, 2)}

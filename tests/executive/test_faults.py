@@ -134,3 +134,30 @@ def test_the_docs_list_every_kind():
     table = (Path(__file__).parent.parent.parent / "docs" / "scenarios.md").read_text()
     for name in FAULT_KINDS:
         assert f"| `{name}` |" in table, name
+
+
+def test_overlapping_faults_of_a_kind_add_up(tmp_path):
+    """A radio is back, a sensor restored, only when no active fault holds it any more."""
+    from delve.executive.runner import Mission
+
+    s = load_scenario(scenario(tmp_path, """
+  - {at_s: 0, robot: anymal, kind: radio_blackout, duration_s: 2}
+  - {at_s: 0.5, robot: anymal, kind: radio_blackout, duration_s: 0.5}
+  - {at_s: 0, robot: anymal, kind: lidar_degraded, range_m: 5, duration_s: 2}
+  - {at_s: 0.5, robot: anymal, kind: lidar_dropout, duration_s: 0.5}
+  - {at_s: 0, link: [anymal, spot], kind: radio_blackout, duration_s: 2}
+  - {at_s: 0.5, kind: base_restart, duration_s: 0.5}
+""", tree="frontier_explorer.yaml"))
+    m = Mission(s, duration_s=3.0)
+    seen = {}
+
+    def watch(mission):
+        robot = mission.robots["anymal"]
+        seen[round(mission.clock.now_s, 1)] = (mission.radio.endpoints["anymal"].blackout,
+                                               mission.radio.endpoints["base"].blackout,
+                                               sorted(mission.radio.cut_links),
+                                               [round(spec.range_m) for spec, _ in robot._sensors])
+    m.run(progress=watch, progress_period_s=0.5)
+    assert seen[0.5] == (True, True, [("anymal", "spot")], [])
+    assert seen[1.0] == (True, False, [("anymal", "spot")], [5, 4]), "the shorter fault's end frees nothing"
+    assert seen[2.0] == (False, False, [], [30, 4])

@@ -114,7 +114,6 @@ def test_a_planner_that_raises_or_is_slow(tmp_path):
     assert len(window) >= 1 and ended["plans_hit"] == len(window)
     assert not [e for e in failed if e["t"] >= 68], "the planner works again after the fault"
     assert events(mission, "gbplanner_path")[-1]["t"] > 68
-    assert "plan" not in vars(mission.agents["anymal"].ctx.services["gbplanner"].planner)
     assert json.loads((tmp_path / "out" / "report.json").read_text())["scenario"] == "faults"
 
 
