@@ -186,6 +186,15 @@ def default_start(world: World) -> np.ndarray:
     return np.array([centre[0], centre[1], floor_z + START_ABOVE_FLOOR_M])
 
 
+def closed_mesh_world(world_mesh: o3d.geometry.TriangleMesh, voxel_size_m: float, name: str) -> World:
+    """A World (start not set yet) from a closed inner surface in metres, z up: its
+    inside by parity along vertical rays; the mesh, with vertex normals, is its rock."""
+    world_mesh.compute_vertex_normals()
+    free, origin = voxelise_interior(world_mesh, voxel_size_m)
+    return World(name=name, voxel_size_m=voxel_size_m, origin=origin, free=free,
+                 mesh=world_mesh, centreline=nx.Graph(), start=np.zeros(3))
+
+
 def from_mesh(path: str | Path, *, scale: float = 1.0, up_axis: str = "z",
               voxel_size_m: float = 0.2, start: Sequence[float] | None = None,
               name: str | None = None) -> World:
@@ -209,10 +218,7 @@ def from_mesh(path: str | Path, *, scale: float = 1.0, up_axis: str = "z",
     verts = (np.asarray(mesh.vertices) * scale) @ rot.T
     world_mesh = o3d.geometry.TriangleMesh(o3d.utility.Vector3dVector(verts),
                                            o3d.utility.Vector3iVector(np.asarray(mesh.triangles)))
-    world_mesh.compute_vertex_normals()
-    free, origin = voxelise_interior(world_mesh, v)
-    world = World(name=name or path.stem, voxel_size_m=v, origin=origin, free=free,
-                  mesh=world_mesh, centreline=nx.Graph(), start=np.zeros(3))
+    world = closed_mesh_world(world_mesh, v, name or path.stem)
     if start is not None:
         world.start = np.asarray(start, dtype=float).reshape(3)
         problem = world.start_problem(world.start)

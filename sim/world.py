@@ -29,6 +29,48 @@ _START_SEARCH_RADIUS_M = 1.0
 START_ABOVE_FLOOR_M = 0.01
 #: Mesh file suffixes that save_mesh and worldgen.from_mesh understand.
 MESH_SUFFIXES = (".ply", ".obj", ".stl")
+#: A floor point offered in a message has this much air above it.
+FLOOR_HEADROOM_M = 1.0
+
+
+@dataclass(frozen=True)
+class WorldSource:
+    """How a world was loaded from a file (see :mod:`delve.sim.worldfile`).
+
+    Fields:
+        file: the file's name.
+        format: "Collada", "PLY", "PCD point cloud", ...
+        free_space: how free space was built: "closed" (parity inside a closed
+            inner surface), "surface" (rock where the surface passes, a ceiling,
+            the floored regions), "points" (inflated points, the floored regions)
+            or "scans" (rays from scan origins).
+        closure: "inner", "solids" or "open" for meshes (see
+            :class:`delve.sim.freespace.Closure`), None for point clouds.
+        boundary_edges: edges of the mesh that only one triangle uses.
+        up_axis: the file's axis that became +z; ``up_axis_from``: "scenario",
+            "file" (what the file declares) or "default".
+        file_up_axis: what the file declares, or None.
+        scale: metres per file unit; ``scale_from``: "scenario", "file" or "default".
+        ceiling_z: the ceiling closing the world (z, m), or None; ``ceiling_from``:
+            "scenario" or "model top".
+        inflation_m: how far rock reaches around each point (point clouds).
+        scan_origins: scan origins used (point clouds with origins).
+    """
+
+    file: str
+    format: str
+    free_space: str
+    closure: str | None = None
+    boundary_edges: int = 0
+    up_axis: str = "z"
+    up_axis_from: str = "default"
+    file_up_axis: str | None = None
+    scale: float = 1.0
+    scale_from: str = "default"
+    ceiling_z: float | None = None
+    ceiling_from: str | None = None
+    inflation_m: float | None = None
+    scan_origins: int = 0
 
 
 @dataclass(kw_only=True, eq=False)
@@ -47,6 +89,7 @@ class World:
             ("tunnel", "cave", "ramp" or "shaft") and ``length_m``. Empty for
             worlds loaded from a mesh.
         start: (3,) default start point on the floor.
+        source: how the world was loaded from a file (None for generated worlds).
     """
 
     name: str
@@ -56,6 +99,7 @@ class World:
     mesh: o3d.geometry.TriangleMesh
     centreline: nx.Graph = field(default_factory=nx.Graph)
     start: np.ndarray
+    source: WorldSource | None = None
 
     _scene: o3d.t.geometry.RaycastingScene | None = field(
         default=None, init=False, repr=False)
@@ -217,14 +261,34 @@ class World:
             idx = self._nearest_free_voxel(start)
         key = tuple(int(i) for i in idx)
         if key not in self._reachable:
-            if self._labels is None:
-                labels, n = ndimage.label(self.free, structure=_CONNECTIVITY_26)
-                dtype = np.min_scalar_type(n)
-                self._labels = labels.astype(dtype, copy=False)
-            comp = self._labels == self._labels[key]
+            labels = self._region_labels()
+            comp = labels == labels[key]
             comp.flags.writeable = False
             self._reachable[key] = comp
         return self._reachable[key]
+
+    def free_regions(self) -> tuple[np.ndarray, np.ndarray]:
+        """(labels, sizes): the free space's 26-connected regions (label 0 is rock) and
+        each label's voxel count (``sizes[0]`` = 0). The labels are cached."""
+        labels = self._region_labels()
+        sizes = np.bincount(labels.ravel())
+        sizes[0] = 0
+        return labels, sizes
+
+    def region_label(self, point: np.ndarray) -> int:
+        """The label (see :meth:`free_regions`) of the free region at ``point``, or of
+        the nearest free voxel within 1 m; ValueError if there is none."""
+        p = np.asarray(point, dtype=float).reshape(3)
+        idx = self.to_index(p)[0]
+        if not (self.in_bounds(idx[None])[0] and self.free[tuple(idx)]):
+            idx = self._nearest_free_voxel(p)
+        return int(self._region_labels()[tuple(int(i) for i in idx)])
+
+    def _region_labels(self) -> np.ndarray:
+        if self._labels is None:
+            labels, n = ndimage.label(self.free, structure=_CONNECTIVITY_26)
+            self._labels = labels.astype(np.min_scalar_type(n), copy=False)
+        return self._labels
 
     # --------------------------------------------------------------- ground
     def ground_height(self, points: np.ndarray, max_drop_m: float) -> np.ndarray:
@@ -263,16 +327,58 @@ class World:
         return out
 
     def start_problem(self, point: np.ndarray) -> str | None:
-        """None if ``point`` is a valid start (inside the grid, in free space), else why not."""
+        """None if ``point`` is a valid start, else why not, with the nearest free floor.
+
+        Valid: inside the grid and in free space, or on a floor, that is in the rock
+        voxel the floor surface passes through with free space right above it."""
         p = np.asarray(point, dtype=float).reshape(3)
         if not self.in_bounds(self.to_index(p))[0]:
             lo, hi = self.bounds_min, self.bounds_max
             return ("outside the world (bounds "
                     f"x∈[{lo[0]:.1f}, {hi[0]:.1f}], y∈[{lo[1]:.1f}, {hi[1]:.1f}], "
-                    f"z∈[{lo[2]:.1f}, {hi[2]:.1f}])")
-        if not self.is_free(p[None])[0]:
-            return "inside rock"
+                    f"z∈[{lo[2]:.1f}, {hi[2]:.1f}])" + self.nearest_floor_hint(p))
+        if not self.is_free(p[None])[0] and not self.on_floor(p):
+            return "inside rock" + self.nearest_floor_hint(p)
         return None
+
+    def on_floor(self, point: np.ndarray) -> bool:
+        """Whether ``point`` lies in a rock voxel with a free voxel right above it (on
+        the floor surface, as a user measures a start on a model)."""
+        idx = self.to_index(point)[0] + np.array([0, 0, 1])
+        return bool(self.in_bounds(idx[None])[0] and self.free[tuple(idx)])
+
+    def nearest_floor(self, point: np.ndarray, headroom_m: float = FLOOR_HEADROOM_M) -> np.ndarray | None:
+        """The floor point nearest to ``point`` in the largest free region: the centre of
+        the bottom face of a free voxel that has rock below and ``headroom_m`` of air
+        above it (any floor when none has that much). None if the world has no floor."""
+        labels, sizes = self.free_regions()
+        if not sizes.any():
+            return None
+        main = labels == int(np.argmax(sizes))
+        floor = main.copy()
+        floor[:, :, 1:] &= ~self.free[:, :, :-1]
+        idx = np.argwhere(floor)
+        head = max(int(np.ceil(headroom_m / self.voxel_size_m)), 1)
+        tall = np.ones(len(idx), dtype=bool)
+        for dz in range(1, head):
+            k = idx[:, 2] + dz
+            ok = k < self.shape[2]
+            tall &= ok
+            tall[ok] &= self.free[idx[ok, 0], idx[ok, 1], k[ok]]
+        if tall.any():
+            idx = idx[tall]
+        p = np.asarray(point, dtype=float).reshape(3)
+        pts = self.index_to_center(idx)
+        pts[:, 2] -= 0.5 * self.voxel_size_m
+        return pts[int(np.argmin(np.linalg.norm(pts - p, axis=1)))]
+
+    def nearest_floor_hint(self, point: np.ndarray) -> str:
+        """`` (nearest free floor: [x, y, z], d m away)``, or "" when the world has no floor."""
+        floor = self.nearest_floor(point)
+        if floor is None:
+            return ""
+        d = float(np.linalg.norm(floor - np.asarray(point, dtype=float).reshape(3)))
+        return f" (nearest free floor: [{floor[0]:.1f}, {floor[1]:.1f}, {floor[2]:.1f}], {d:.1f} m away)"
 
     # ------------------------------------------------------------------ io
     def save_mesh(self, path: str | Path) -> None:

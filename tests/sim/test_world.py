@@ -189,7 +189,20 @@ def test_start_problem(twin):
     msg = twin.start_problem(np.array([500.0, 0.0, 1.0]))
     assert msg.startswith("outside the world (bounds x∈[")
     assert "y∈[" in msg and "z∈[" in msg
-    assert twin.start_problem(np.array([15.0, 6.0, 1.0])) == "inside rock"
+    assert twin.start_problem(np.array([15.0, 6.0, 1.0])) == \
+        "inside rock (nearest free floor: [14.9, 1.9, 0.0], 4.2 m away)"
+    # on the floor surface: in the rock voxel it passes through, free right above
+    assert twin.start_problem(np.array([15.0, 0.0, -0.1])) is None
+    deep = twin.start_problem(np.array([15.0, 0.0, -0.3]))
+    assert deep.startswith("inside rock (nearest free floor: [") and deep.endswith(", 0.0], 0.3 m away)")
+
+
+def test_nearest_floor_and_regions(twin):
+    labels, sizes = twin.free_regions()
+    assert np.count_nonzero(sizes) == 2 and sizes[0] == 0
+    assert twin.region_label([5.0, 0.0, 0.5]) != twin.region_label([5.0, 12.0, 0.5])
+    floor = twin.nearest_floor(np.array([5.0, 0.5, -2.0]))
+    np.testing.assert_allclose(floor, [5.1, 0.5, 0.0], atol=V)
 
 
 @pytest.mark.parametrize("suffix", [".ply", ".obj", ".stl"])
