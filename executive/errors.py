@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import difflib
 import os
+import re
 import warnings
 from collections.abc import Iterable
 from pathlib import Path
@@ -29,6 +30,14 @@ def display_path(path: str | os.PathLike[str]) -> str:
         if not rel.startswith(os.pardir):
             return rel
     return text
+
+
+def clip_message(text: object, limit: int = 160) -> str:
+    """Words from elsewhere (a builder's or a reader's exception, which may quote a
+    user's value) made fit for one line: whitespace folded, every run of 40 or more
+    characters without a space cut to 40, the whole cut to ``limit``."""
+    words = re.sub(r"\S{41,}", lambda m: m.group()[:37] + "...", " ".join(str(text).split()))
+    return words if len(words) <= limit else words[:limit] + "..."
 
 
 def did_you_mean(word: str, candidates: Iterable[str]) -> str:

@@ -21,7 +21,7 @@ from .supervisor import Command, load_supervisor
 from .teams import DEFAULT_STRATEGY, TEAM_STRATEGIES, TeamStrategy, implied_strategy
 from .worlds import WorldBackend, backend_for, generator_names
 from ..skills.base import short_repr, yaml_number_hint
-from .yamlio import YamlDict, YamlList, load_yaml, plain
+from .yamlio import YamlDict, YamlList, file_problem, load_yaml, plain
 
 SCHEMA_PATH = Path(__file__).parent / "schema" / "scenario.schema.json"
 DEFAULTS = {"seed": 0, "duration_s": 3600.0, "dt_s": 0.1, "coverage_period_s": 5.0}
@@ -266,10 +266,11 @@ def load_scenario(path: str | Path, include_path: Iterable[str | Path] = ()) -> 
             why = "is used twice" if r["name"] in names else "is reserved for the base station"
             raise DelveError(f"robot name {short_repr(r['name'])} {why}", path, line)
         names.add(r["name"])
+        problem = file_problem(path.parent / r["tree"])
+        if problem:
+            raise DelveError(f"robot {short_repr(r['name'])}: tree file {problem}: {short_repr(r['tree'])[1:-1]}",
+                             path, r.key_line("tree"))
         tree = (path.parent / r["tree"]).resolve()
-        if not tree.exists():
-            raise DelveError(f"robot {short_repr(r['name'])}: tree file not found: {short_repr(r['tree'])[1:-1]}", path,
-                             r.key_line("tree"))
         robot_types[r["name"]] = check_tree(tree, include_path=include_path)
         tree_types |= robot_types[r["name"]]
         extra = {k: float(r[k]) for k in ("speed_mps", "max_inclination_deg", "max_step_m") if k in r}
@@ -281,10 +282,11 @@ def load_scenario(path: str | Path, include_path: Iterable[str | Path] = ()) -> 
     base = doc.get("base_station", {})
     base_tree = None
     if "tree" in base:
-        base_tree = (path.parent / base["tree"]).resolve()
-        if not base_tree.exists():
-            raise DelveError(f"base station tree file not found: {short_repr(base['tree'])[1:-1]}", path,
+        problem = file_problem(path.parent / base["tree"])
+        if problem:
+            raise DelveError(f"base station tree file {problem}: {short_repr(base['tree'])[1:-1]}", path,
                              base.key_line("tree"))
+        base_tree = (path.parent / base["tree"]).resolve()
         tree_types |= check_tree(base_tree, include_path=include_path)
     supervisor = load_supervisor(doc.get("supervisor"), path, {r.name: r.breadcrumbs for r in robots})
     faults = load_faults(doc.get("faults"), FaultContext(path, {r.name: r for r in robots}, robot_types, backend,

@@ -35,9 +35,9 @@ from py_trees.behaviour import Behaviour
 
 from .. import TREES_DIR
 from ..skills.base import AgentContext, short_repr
-from .errors import DelveError, did_you_mean, display_path
+from .errors import DelveError, clip_message, did_you_mean, display_path
 from .registry import Build, NodeType, Registry, Site, coerce_param, default_registry
-from .yamlio import YamlDict, YamlList, line_of, line_of_key_named, load_yaml
+from .yamlio import YamlDict, YamlList, file_problem, line_of, line_of_key_named, load_yaml
 
 __all__ = ["MAX_TREE_DEPTH", "build_tree", "check_context", "check_tree", "compose_remap", "load_tree"]
 
@@ -75,11 +75,6 @@ def _describe(value: Any) -> str:
     if isinstance(value, str):
         return f"the string {short_repr(value)}"
     return f"{type(value).__name__} {short_repr(value)}"
-
-
-def _clip(text: str, limit: int = _BUILD_ERROR_CHARS) -> str:
-    text = " ".join(str(text).split())
-    return text if len(text) <= limit else text[:limit] + "..."
 
 
 def allowed_include_roots(tree_file: str | os.PathLike[str] | None,
@@ -186,8 +181,8 @@ class _TreeBuilder:
                     hint = " (a node is either an include or a typed node, not both)"
                 site.fail(f"unknown key {short_repr(key)} in an include{hint}", key)
         target = data["include"]
-        if not isinstance(target, str) or not target:
-            site.fail(f"'include' must be a path (a string), not {_describe(target)}", "include")
+        if not isinstance(target, str) or not target or "\0" in target:
+            site.fail(f"'include' must be a path (a string without NUL bytes), not {_describe(target)}", "include")
         inner = data.get("remap") or {}
         if not isinstance(inner, Mapping):
             site.fail(f"'remap' must be a mapping of subtree key -> key, not {_describe(inner)}", "remap")
@@ -211,10 +206,9 @@ class _TreeBuilder:
         if real in chain:
             names = [self.chain_name(p) for p in chain[chain.index(real):]] + [self.chain_name(real)]
             site.fail(f"include cycle: {' -> '.join(names)}", "include")
-        if not os.path.isfile(path):
-            what = "is a directory" if os.path.isdir(path) else "is not a regular file" if os.path.exists(path) else \
-                "not found"
-            site.fail(f"included file {what}: {short_repr(target)} (relative to {display_path(base or '.')})",
+        problem = file_problem(path)
+        if problem:
+            site.fail(f"included file {problem}: {short_repr(target)} (relative to {display_path(base or '.')})",
                       "include")
         root = self.file(path, compose_remap(inner, remap), (*chain, real), site)
         if name is not None:
@@ -264,7 +258,7 @@ class _TreeBuilder:
         except DelveError:
             raise
         except (ValueError, TypeError) as err:  # the builder refused the checked parameters
-            raise DelveError(f"cannot build {type_name!r}: {_clip(err)}", file,
+            raise DelveError(f"cannot build {type_name!r}: {clip_message(err, _BUILD_ERROR_CHARS)}", file,
                              line_of_key_named(data, str(err)) or site.line, site.node_name) from None
 
     def params(self, node_type: NodeType, data: Mapping[str, Any], site: Site) -> tuple[dict[str, Any], list[str]]:

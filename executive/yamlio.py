@@ -31,7 +31,7 @@ from ..skills.base import short_repr
 from .errors import DelveError
 
 __all__ = ["MAX_FILE_BYTES", "MAX_NESTING_DEPTH", "MAX_NODES", "YamlDict", "YamlList", "decode", "line_of",
-           "line_of_key_named", "load_yaml", "loads_yaml", "plain"]
+           "file_problem", "line_of_key_named", "load_yaml", "loads_yaml", "plain"]
 
 #: Largest YAML file read, in bytes. The shipped trees and scenarios are under 4 kB;
 #: the pure-Python parser reads about 100 kB a second on a busy machine.
@@ -306,6 +306,21 @@ def decode(data: bytes, file: str | None = None) -> str:
             pass
         raise DelveError(f"not UTF-8 text: byte 0x{byte:02x} in column {column} cannot be decoded{guess}; "
                          "save the file as UTF-8", file, line) from None
+
+
+def file_problem(path: str | os.PathLike[str]) -> str | None:
+    """Why a file that a tree or scenario names cannot be read ("not found", "is a
+    directory", ...), or None for a regular file. Names the system refuses (too long,
+    a NUL byte in them) are a problem too, never an exception."""
+    try:
+        mode = os.stat(path).st_mode
+    except FileNotFoundError:
+        return "not found"
+    except (OSError, ValueError) as err:  # ENAMETOOLONG, ELOOP, EACCES; embedded NUL
+        return f"cannot be used ({getattr(err, 'strerror', None) or 'a NUL byte in its name'})"
+    if stat.S_ISDIR(mode):
+        return "is a directory"
+    return None if stat.S_ISREG(mode) else "is not a regular file"
 
 
 def load_yaml(path: str | os.PathLike[str]) -> Any:

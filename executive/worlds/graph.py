@@ -16,7 +16,7 @@ from ...sim.graph_world import GraphWorld
 from ...sim.platforms import PLATFORMS
 from ...skills.base import AgentContext, short_repr
 from ..errors import DelveError
-from ..yamlio import YamlDict, line_of_key_named
+from ..yamlio import YamlDict, file_problem, line_of_key_named
 from . import graph_sources
 from .base import BASE, Coverage, TeamNetwork, WorldBackend, only_keys
 from .graph_plot import plot_graph_map
@@ -54,8 +54,9 @@ class GraphBackend(WorldBackend):
         if "network" in world:
             only_keys(world, ("network",), "world: unknown parameter", path)
             net_path = path.parent / world["network"]
-            if not net_path.exists():
-                raise DelveError(f"network file not found: {short_repr(world['network'])[1:-1]}", path,
+            problem = file_problem(net_path)
+            if problem:
+                raise DelveError(f"network file {problem}: {short_repr(world['network'])[1:-1]}", path,
                                  world.key_line("network"))
             graph_sources.load_network_world(net_path)
         super().check(doc, path, has_base_tree)

@@ -6,13 +6,14 @@ the scenario is loaded, with its file and line.
 """
 from __future__ import annotations
 
+import math
 import re
 from pathlib import Path
 from typing import Any
 
 from ...planners.cops.network import MCNetwork, network_from_dict, tunnel_network_graph
 from ...sim.graph_world import GraphWorld
-from ..errors import DelveError
+from ..errors import DelveError, clip_message
 from ..yamlio import YamlDict, YamlList, load_yaml, plain
 
 
@@ -47,10 +48,23 @@ def load_network_world(path: Path) -> GraphWorld:
     doc = load_yaml(path)
     if not isinstance(doc, YamlDict):
         raise DelveError("a network file must be a mapping", path, getattr(doc, "line", 1))
+    _finite_numbers(doc, path)
     try:
         return world_of(network_from_dict(plain(doc)))
-    except ValueError as err:
-        raise DelveError(f"network: {err}", path, _line_of(doc, str(err))) from None
+    except (ValueError, TypeError) as err:
+        raise DelveError(f"network: {clip_message(err, 100)}", path, _line_of(doc, str(err))) from None
+
+
+def _finite_numbers(value: Any, path: Path) -> None:
+    """A DelveError at the first NaN, infinity or integer beyond a float's range."""
+    items = value.items() if isinstance(value, dict) else enumerate(value) if isinstance(value, list) else ()
+    for key, item in items:
+        bad = isinstance(item, float) and not math.isfinite(item)
+        huge = isinstance(item, int) and not isinstance(item, bool) and abs(item) > 2.0 ** 1023
+        if bad or huge:
+            line = value.key_line(key) if isinstance(value, YamlDict) else value.item_line(key)
+            raise DelveError("network: numbers must be finite and within +-1.8e308", path, line)
+        _finite_numbers(item, path)
 
 
 def _line_of(doc: YamlDict, message: str) -> int | None:

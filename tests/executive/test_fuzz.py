@@ -6,11 +6,13 @@ Two properties, checked with hypothesis:
   with hostile values (NaN, huge integers, control characters, nested lists and
   mappings, YAML 1.1 traps like ``1e3``, includes of files outside the tree's folder);
 - the shipped trees and scenarios with random bytes spliced in (YAML punctuation,
-  NUL, invalid UTF-8, byte-order marks, line breaks).
+  NUL, invalid UTF-8, byte-order marks, line breaks);
+- a COPS network file with hostile values in place of valid ones.
 
 Loading either succeeds or raises :class:`DelveError`, never anything else; its
 message is one line, has no traceback, and quotes no long run of the file.
-1200 generated trees and 900 spliced files take about 20 s on a shared machine.
+1000 generated trees, 700 spliced files and 300 network files take some 15 s of CPU
+(20-40 s on a shared machine).
 """
 from __future__ import annotations
 
@@ -29,6 +31,7 @@ from delve.executive.errors import DelveError
 from delve.executive.registry import default_registry
 from delve.executive.scenario import load_scenario
 from delve.executive.tree_loader import check_tree
+from delve.executive.worlds.graph_sources import load_network_world
 
 #: A value no message may quote in full (messages cut values to a few dozen characters).
 CANARY = "canary-" + "q" * 93
@@ -141,7 +144,7 @@ def quiet():
     py_trees.blackboard.Blackboard.clear()
 
 
-@settings(FUZZ, max_examples=1200)
+@settings(FUZZ, max_examples=1000)
 @given(node=tree_nodes())
 def test_generated_trees_load_or_give_one_line(workdir, node):
     path = workdir / "generated.yaml"
@@ -174,7 +177,7 @@ def splice(data: bytes, edits: list[tuple[float, str, bytes]]) -> bytes:
     return data
 
 
-@settings(FUZZ, max_examples=900)
+@settings(FUZZ, max_examples=700)
 @given(relative=st.sampled_from(SHIPPED), edits=EDITS)
 def test_shipped_files_with_spliced_bytes_load_or_give_one_line(workdir, relative, edits):
     path = workdir / relative
@@ -189,3 +192,40 @@ def test_shipped_files_with_spliced_bytes_load_or_give_one_line(workdir, relativ
         assert_one_clear_line(err)
     finally:
         path.write_bytes(original)
+
+
+NETWORK = {"base": "s0",
+           "locations": [{"name": "s0", "pos": [0, 0]}, {"name": "s1", "pos": [50, 0]},
+                         {"name": "s2", "pos": [50, 50, 3]}],
+           "mobility": [["s0", "s1"], ["s1", "s2"]],
+           "communication": [{"from": "s0", "to": "s1", "cost": 0.5}, ["s1", "s2"]]}
+
+
+def places(value, where=()):
+    """Every path into ``value`` (its keys and indices)."""
+    yield where
+    items = value.items() if isinstance(value, dict) else enumerate(value) if isinstance(value, list) else ()
+    for key, item in items:
+        yield from places(item, (*where, key))
+
+
+@settings(FUZZ, max_examples=300)
+@given(data=st.data())
+def test_network_files_with_hostile_values_load_or_give_one_line(workdir, data):
+    """A COPS scenario's network file with one to three values made hostile."""
+    network = yaml.safe_load(yaml.safe_dump(NETWORK))
+    targets = [p for p in places(network) if p]
+    for where in data.draw(st.lists(st.sampled_from(targets), min_size=1, max_size=3)):
+        parent = network
+        try:
+            for key in where[:-1]:
+                parent = parent[key]
+            parent[where[-1]] = data.draw(VALUES)
+        except (KeyError, IndexError, TypeError):  # an earlier change removed the path
+            pass
+    path = workdir / "network.yaml"
+    path.write_text(yaml.safe_dump(network, allow_unicode=True))
+    try:
+        load_network_world(path)
+    except DelveError as err:
+        assert_one_clear_line(err)
