@@ -3,6 +3,7 @@
     delve run SCENARIO [--out DIR] [--seed N] [--duration-s S] [--quiet] [--include-path DIR]...
     delve validate FILE... | --shipped [--include-path DIR]...
     delve render TREE --format svg|dot|png|txt [--out PATH] [--include-path DIR]...
+    delve world SCENARIO [--preview DIR] [--seed N] [--include-path DIR]...
     delve demo
 
 Exit status: 0 when the mission succeeds (every robot's tree ends in SUCCESS, every
@@ -41,7 +42,12 @@ def _parser() -> argparse.ArgumentParser:
     ren.add_argument("tree", type=Path)
     ren.add_argument("--format", choices=("svg", "dot", "png", "txt"), default="txt")
     ren.add_argument("--out", type=Path, help="output file (default: TREE with the format's suffix)")
-    for command in (run, val, ren):
+    wld = sub.add_parser("world", help="load a scenario's world and say what it is: extent, free space, "
+                                       "where each start lands, warnings")
+    wld.add_argument("scenario", type=Path, help="a scenario file, or the name of a shipped one")
+    wld.add_argument("--preview", type=Path, metavar="DIR", help="also draw top.png and side.png into DIR")
+    wld.add_argument("--seed", type=int, help="override the scenario's seed (generated worlds)")
+    for command in (run, val, ren, wld):
         command.add_argument("--include-path", type=Path, action="append", default=[], metavar="DIR",
                              help="a folder that tree includes may also resolve into (besides the tree's own "
                                   "folder and the shipped trees); repeatable")
@@ -84,6 +90,8 @@ def _command(args: argparse.Namespace) -> int:
             if not args.files and not shipped:
                 raise DelveError("validate: name the files to check, or --shipped")
             return validate(args.files + shipped, include_path)
+        if args.command == "world":
+            return world(shipped_or_given(args.scenario), args.preview, args.seed, include_path)
         if args.command == "render":
             return render(args.tree, args.format, args.out, include_path)
     except DelveError as err:
@@ -116,7 +124,10 @@ def run(path: Path, out: Path | None, seed: int | None, duration_s: float | None
     scenario = load_scenario(path, include_path=include_path)
     out = out or Path("delve-out") / scenario.name
     started = time.perf_counter()
-    mission = Mission(scenario, seed=seed, duration_s=duration_s)
+    loaded = scenario.build_world(seed)
+    if not _print_world(scenario.world_backend.describe(scenario, loaded), quiet):
+        return 2
+    mission = Mission(scenario, seed=seed, duration_s=duration_s, world=loaded)
     if quiet:
         mission.run()
     else:
@@ -136,6 +147,34 @@ def run(path: Path, out: Path | None, seed: int | None, duration_s: float | None
               f"home={'yes' if r['returned_home'] else 'no'}, {r['endurance_left_s']:.0f} s endurance left")
     print(f"outputs in {out}/")
     return 0 if rep["succeeded"] else 1
+
+
+def world(path: Path, preview: Path | None, seed: int | None, include_path: tuple[Path, ...] = ()) -> int:
+    """Load a scenario's world, print what it is and where each start lands (and its
+    warnings); with ``preview``, draw it. Exit 2 when a start cannot be used."""
+    from .scenario import load_scenario
+
+    if seed is not None and seed < 0:
+        raise DelveError(f"--seed must be >= 0, got {seed}")
+    scenario = load_scenario(path, include_path=include_path)
+    loaded = scenario.build_world(seed)
+    ok = _print_world(scenario.world_backend.describe(scenario, loaded), quiet=False)
+    if preview is not None:
+        for written in scenario.world_backend.preview(scenario, loaded, preview):
+            print(f"wrote {written}")
+    return 0 if ok else 2
+
+
+def _print_world(description, quiet: bool) -> bool:
+    """Print a world's description (not when ``quiet``), its warnings and errors (to
+    stderr, always); whether it has no errors."""
+    if not quiet:
+        print("\n".join(description.lines))
+    for line in description.warnings:
+        print(f"warning: {line}", file=sys.stderr)
+    for err in description.errors:
+        print(err, file=sys.stderr)
+    return not description.errors
 
 
 def _run_with_progress(mission) -> None:

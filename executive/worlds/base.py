@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import inspect
 from abc import ABC, abstractmethod
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar, Mapping
 
@@ -50,6 +50,19 @@ class TeamNetwork:
     team: dict[str, str]
     base_location: str
     initial_topology: dict[str, Any]
+
+
+@dataclass
+class WorldDescription:
+    """What ``delve world`` prints and ``delve run`` prints first: ``lines`` (the
+    world's figures and where each start lands), ``warnings`` (one line each, with
+    the file and line of the key at fault), ``errors`` (what stops a run: a start in
+    rock, say) and ``starts`` (robot name -> the ground point it starts on)."""
+
+    lines: list[str] = field(default_factory=list)
+    warnings: list[str] = field(default_factory=list)
+    errors: list[DelveError] = field(default_factory=list)
+    starts: dict[str, list[float]] = field(default_factory=dict)
 
 
 class WorldBackend(ABC):
@@ -99,6 +112,18 @@ class WorldBackend(ABC):
     def build_world(cls, scenario: "Scenario", seed: int) -> Any:
         """Generate or load the world; a :class:`DelveError` when its parameters are
         wrong. A generator without its own ``seed`` takes ``seed``."""
+
+    @classmethod
+    def describe(cls, scenario: "Scenario", world: Any) -> WorldDescription:
+        """The world's figures, where each start lands, and what looks wrong (without
+        making robots). The default names the kind of world only."""
+        return WorldDescription(lines=[f"world {scenario.name}: a {cls.__name__} world"])
+
+    @classmethod
+    def preview(cls, scenario: "Scenario", world: Any, out: Path) -> list[Path]:
+        """Write pictures of the world (a top-down and a side view, with the starts)
+        into the folder ``out``; the files written."""
+        raise DelveError(f"this world ({cls.__name__}) draws no preview")
 
     # ---- a mission ----------------------------------------------------------------
     @abstractmethod

@@ -16,23 +16,24 @@ from ...sim.radio import RadioNetwork, RadioSpec
 from ...sim.robot import SimRobot
 from ...sim.voxel_map import UNKNOWN, VoxelMap
 from ...sim.world import World
+from ...sim.worldfile import from_file
 from ...skills.base import AgentContext
 from ...skills.cops.voxel_view import VoxelNetworkView
 from ...skills.navigation import navigator
 from ..errors import DelveError
 from ..yamlio import YamlDict, line_of_key_named
-from .base import BASE, Coverage, TeamNetwork, WorldBackend, only_keys
+from .base import BASE, Coverage, TeamNetwork, WorldBackend, WorldDescription, only_keys
+from .voxel_check import describe_voxel_world, place_starts
 from .voxel_plot import plot_voxel_map
+from .voxel_preview import draw_preview
 
 if TYPE_CHECKING:
     from ..runner import Mission
     from ..scenario import RobotSpec, Scenario
 
-#: What a ``world: {mesh: ...}`` mapping may hold besides the file.
-MESH_OPTIONS = ("mesh", "scale", "up_axis", "voxel_size_m", "start", "seed")
-#: Where robots without a ``start`` stand, around the world's start (m), in order.
-START_OFFSETS_M = [(0, 0), (1.2, 0), (-1.2, 0), (0, 1.2), (0, -1.2), (2.4, 0), (-2.4, 0), (2.4, 1.2),
-                   (-2.4, 1.2), (2.4, -1.2), (-2.4, -1.2), (3.6, 0), (-3.6, 0)]
+#: What a ``world: {mesh: ...}`` mapping may hold besides the file (docs/worlds.md).
+MESH_OPTIONS = ("mesh", "scale", "up_axis", "voxel_size_m", "start", "seed", "ceiling_m", "scan_origins",
+                "trajectory", "inflation_m")
 
 
 class VoxelBackend(WorldBackend):
@@ -67,7 +68,14 @@ class VoxelBackend(WorldBackend):
                 if not mesh.exists():
                     raise DelveError(f"mesh file not found: {mesh}", scenario.path, where.key_line("mesh"))
                 spec.pop("seed", None)
-                return worldgen.from_mesh(mesh, **spec)
+                if "trajectory" in spec:
+                    given = spec["trajectory"]
+                    spec["trajectory"] = (scenario.path.parent / given).resolve()
+                    if not spec["trajectory"].is_file():
+                        raise DelveError(f"trajectory file not found: {given}", scenario.path,
+                                         where.key_line("trajectory"))
+                seeds = [r.start for r in scenario.robots if r.start is not None]
+                return from_file(mesh, seeds=seeds, **spec)
             generate = cls.generators()[spec.pop("generator")]
             spec.setdefault("seed", seed)
             return generate(**spec)
@@ -81,8 +89,13 @@ class VoxelBackend(WorldBackend):
                                   lambda: clock.now_s)
         self.robots: dict[str, SimRobot] = {}
         self._next_scan: dict[str, float] = {}
-        for i, spec in enumerate(scenario.robots):
-            self.robots[spec.name] = self._robot(spec, i)
+        #: Where each robot starts (the ground point under it).
+        self.starts: dict[str, np.ndarray] = {}
+        for spec, placed in zip(scenario.robots, place_starts(scenario, world)):
+            if placed.error is not None:
+                raise placed.error
+            self.starts[spec.name] = placed.landing.start
+            self.robots[spec.name] = self._robot(spec, placed.landing.start)
             self._next_scan[spec.name] = 0.0
         base_pos = np.asarray(scenario.base_position if scenario.base_position is not None
                               else world.start + np.array([0.0, 0.0, 1.0]), dtype=float)
@@ -93,24 +106,22 @@ class VoxelBackend(WorldBackend):
         #: Flat indices of the free voxels the team should explore (ground truth).
         self.truth = np.flatnonzero(reach.reshape(-1))
 
-    def _robot(self, spec: "RobotSpec", index: int) -> SimRobot:
+    def _robot(self, spec: "RobotSpec", start: np.ndarray) -> SimRobot:
         base = PLATFORMS[spec.platform]
         platform = replace(base, **spec.overrides, lidar=replace(base.lidar, **spec.lidar))
-        start = np.asarray(spec.start, float) if spec.start is not None else self._free_start(index)
         holder: dict[str, SimRobot] = {}
         radio = self.radio.add(spec.name, lambda: holder["r"].true_position, breadcrumbs=spec.breadcrumbs)
         robot = SimRobot(spec.name, platform, self.world, start, radio, spec.endurance_s)
         holder["r"] = robot
         return robot
 
-    def _free_start(self, index: int) -> np.ndarray:
-        """A start on the floor near the world's start, a little apart for each robot."""
-        free = [np.asarray(self.world.start) + np.array([dx, dy, 0.0]) for dx, dy in START_OFFSETS_M]
-        free = [p for p in free if self.world.start_problem(p + np.array([0, 0, 0.3])) is None]
-        if index >= len(free):
-            raise DelveError(f"no free start pose near the world's start for robot #{index + 1}",
-                             self.scenario.path, self.scenario.robots[index].line)
-        return free[index]
+    @classmethod
+    def describe(cls, scenario: "Scenario", world: World) -> WorldDescription:
+        return describe_voxel_world(scenario, world)
+
+    @classmethod
+    def preview(cls, scenario: "Scenario", world: World, out: Path) -> list[Path]:
+        return draw_preview(scenario, world, place_starts(scenario, world), out)
 
     def first_start(self) -> np.ndarray:
         """The ground point under the first robot's start."""
@@ -166,7 +177,8 @@ class VoxelBackend(WorldBackend):
         return {"free_volume_m3": round(len(self.truth) * self.world.voxel_size_m ** 3, 1)}
 
     def robot_figures(self, name: str, lost: Mapping[str, str]) -> dict[str, Any]:
-        return {"lost": name in lost} if lost else {}
+        start = {"start": [round(float(c), 3) for c in self.starts[name]]}
+        return {**start, "lost": name in lost} if lost else start
 
     def map_undelivered(self, name: str) -> int:
         """Voxels robot ``name`` knows (free or rock) that are unknown in the base map."""
