@@ -6,17 +6,22 @@ from typing import Any
 
 #: Per plan, the fields of its ``cops_plan`` event that the report keeps.
 PLAN_FIELDS = ("cycle", "final", "robots", "locations", "frontiers", "explorers", "T_pre", "T_post", "ext_com",
-               "int_com", "transitions", "relayed", "clustered")
+               "int_com", "transitions", "relayed", "clustered", "work")
 
 
 def cops_figures(events: list[dict[str, Any]]) -> dict[str, Any]:
-    """Cycles, plans that passed the validator, why planning failed, and each plan."""
+    """Cycles, plans that passed the validator, why planning failed, each plan (with
+    its work: simplex iterations), and the safety stops (wall clock) that fired while
+    planning: with one, the run may not be reproducible (``reproducible`` is false)."""
     plans = [e for e in events if e["event"] == "cops_plan"]
+    stops = sum(e["count"] for e in events if e["event"] == "cops_safety_stop")
     return {
         "cycles": len(plans),
         "plans_valid": sum(1 for e in plans if e.get("valid")),
         "no_plan": [e["reason"] for e in events if e["event"] in ("cops_no_plan", "cops_invalid_plan")],
-        "plans": [{k: e[k] for k in PLAN_FIELDS} for e in plans],
+        "safety_stops": stops,
+        "reproducible": stops == 0,
+        "plans": [{k: e.get(k) for k in PLAN_FIELDS} for e in plans],
     }
 
 

@@ -1,42 +1,125 @@
-"""The time budget of one planning call (``SolverOptions.total_time_limit_s``), shared
-out over its solves."""
+"""The limits of one planning call (``plan_cycle``, ``solve_pre_exploration``, ...),
+shared out over its solves.
+
+Results depend only on work, never on the wall clock: every solve is bounded by
+branch-and-bound nodes and checkpoint work (:class:`SolveLimits`), and a call by
+the simplex iterations of its solves (``SolverOptions.total_work``), which
+decides how many probes of a horizon search are made. Seconds remain as safety
+stops only (``time_limit_s``, ``total_time_limit_s``): when one fires, the
+:class:`Meter` of the call (and of every call enclosing it) counts it, so that the
+caller can report a result that may not be reproducible.
+"""
 from __future__ import annotations
 
+import threading
 import time
-from dataclasses import replace
+from dataclasses import dataclass, replace
 
 from .ilp_problem import SolverOptions
 
-#: However little of ``total_time_limit_s`` is left, a solve gets at least this long.
-MIN_SOLVE_TIME_S = 0.3
-#: Share of a cycle's time budget given to pre-exploration (post-exploration gets the rest).
+#: However little work is left, a solve that must run (the plan at the horizon found)
+#: gets this much checkpoint work: presolve, the root LP and a round or two after it.
+MIN_SOLVE_WORK = 3
+#: However little of a safety stop is left, a solve gets this long (s).
+MIN_SAFETY_S = 1.0
+#: Share of a cycle's work budget given to pre-exploration (post-exploration gets the rest).
 PRE_SHARE = 0.55
 
 
+class Meter:
+    """Work done by the solves of a planning call (simplex iterations, solves) and the
+    safety stops that fired, each also counted in the enclosing call's meter
+    (``parent``). Thread-safe: clusters are solved at once."""
+
+    def __init__(self, parent: Meter | None = None) -> None:
+        self.parent = parent
+        self.work = 0
+        self.solves = 0
+        self.safety_stops: list[str] = []
+        self._lock = threading.Lock()
+
+    def add(self, work: int = 0, solves: int = 0, safety_stop: str | None = None) -> None:
+        m: Meter | None = self
+        while m is not None:
+            with m._lock:
+                m.work += int(work)
+                m.solves += solves
+                if safety_stop:
+                    m.safety_stops.append(safety_stop)
+            m = m.parent
+
+    def figures(self) -> dict:
+        """``work``, ``solves`` and ``safety_stops`` (a count), for a plan's meta."""
+        return {"work": self.work, "solves": self.solves, "safety_stops": len(self.safety_stops)}
+
+
+@dataclass(frozen=True)
+class SolveLimits:
+    """The limits of one solve: work (nodes, checkpoint work, stall, all deterministic)
+    and a wall-clock safety stop (``time_limit_s``); see :class:`SolverOptions`."""
+
+    max_nodes: int | None = None
+    max_work: float | None = None
+    stall_work: float | None = None
+    time_limit_s: float | None = None
+
+    @classmethod
+    def of(cls, opts: SolverOptions, probe: bool = False) -> SolveLimits:
+        """The limits ``opts`` give a solve (a feasibility probe: ``probe``)."""
+        if probe:
+            return cls(opts.probe_max_nodes, opts.probe_max_work, None, opts.probe_time_limit_s)
+        return cls(opts.max_nodes, opts.max_work, opts.stall_work, opts.time_limit_s)
+
+
 class Budget:
-    """The time left of ``options.total_time_limit_s`` and the limit of the next solve."""
+    """The work left of ``options.total_work`` (simplex iterations) and the safety
+    stop ``options.total_time_limit_s`` of one planning call. Its solves use
+    :attr:`opts`, whose meter counts the call's work (and its parents' too)."""
 
     def __init__(self, opts: SolverOptions) -> None:
-        self.opts = opts
-        total = opts.total_time_limit_s
-        self.end = None if total is None else time.perf_counter() + total
+        self.meter = Meter(opts.meter)
+        self.opts = replace(opts, meter=self.meter)
+        self.total = opts.total_work
+        total_s = opts.total_time_limit_s
+        self.end = None if total_s is None else time.perf_counter() + total_s
+        self._stopped = False
 
-    def left(self) -> float | None:
-        return None if self.end is None else max(self.end - time.perf_counter(), 0.0)
+    def left(self) -> int | None:
+        """Work left (simplex iterations); None without a budget."""
+        return None if self.total is None else max(self.total - self.meter.work, 0)
 
-    def limit(self, share: float = 1.0, probe: bool = False) -> float | None:
-        """Time limit of the next solve: ``time_limit_s`` (``probe_time_limit_s``), cut to
-        ``share`` of the time left (at least :data:`MIN_SOLVE_TIME_S`)."""
-        lim = self.opts.probe_time_limit_s if probe else self.opts.time_limit_s
+    def spent(self, reserve: int = 0) -> bool:
+        """Whether no more than ``reserve`` work is left, or the safety stop has passed
+        (counted once as a safety stop): a search stops here."""
         left = self.left()
-        if left is None:
-            return lim
-        cut = max(MIN_SOLVE_TIME_S, left * share)
-        return cut if lim is None else min(lim, cut)
+        if left is not None and left <= reserve:
+            return True
+        if self.end is not None and time.perf_counter() > self.end:
+            if not self._stopped:
+                self._stopped = True
+                self.meter.add(safety_stop=f"planning call ran past its safety stop of "
+                                          f"{self.opts.total_time_limit_s:g} s")
+            return True
+        return False
+
+    def limits(self, probe: bool = False) -> SolveLimits:
+        """Limits of the next solve: those of the options, with at most
+        :data:`MIN_SOLVE_WORK` once the call's work is spent, and a safety stop cut to
+        the call's time left (at least :data:`MIN_SAFETY_S`)."""
+        lim = SolveLimits.of(self.opts, probe)
+        left = self.left()
+        if left is not None and left <= 0:
+            w = lim.max_work
+            lim = replace(lim, max_work=MIN_SOLVE_WORK if w is None else min(w, MIN_SOLVE_WORK))
+        if self.end is not None:
+            cut = max(self.end - time.perf_counter(), MIN_SAFETY_S)
+            lim = replace(lim, time_limit_s=cut if lim.time_limit_s is None else min(lim.time_limit_s, cut))
+        return lim
 
     def options(self, share: float = 1.0) -> SolverOptions:
-        """Options for a sub-problem that may use ``share`` of the time left."""
+        """Options for a sub-problem that may use ``share`` of the work left (and the
+        time left of the safety stop); its work is counted here too."""
         left = self.left()
-        if left is None:
-            return self.opts
-        return replace(self.opts, total_time_limit_s=max(MIN_SOLVE_TIME_S, left * share))
+        total_s = None if self.end is None else max(self.end - time.perf_counter(), MIN_SAFETY_S)
+        return replace(self.opts, total_work=None if left is None else int(left * share),
+                       total_time_limit_s=total_s)

@@ -26,7 +26,6 @@ from __future__ import annotations
 
 import math
 import time
-import threading
 from collections import defaultdict, deque
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
@@ -306,23 +305,17 @@ def _solve_all(jobs: list[tuple[str, float, Callable[[SolverOptions], Plan]]],
                opts: SolverOptions) -> dict[str, Plan]:
     """Run independent cluster problems, ``opts.workers`` at once (the solver releases
     the interpreter while it works). A job (name, weight, solve) may use the share of
-    the time left that its weight has among the jobs not yet started (times the
-    number of workers); raises the first job's error, if any."""
+    the work budget that its weight has among all jobs, decided before any starts, so
+    that plans do not depend on which job finishes first (nor on ``workers``); raises
+    the first job's error, if any."""
     budget = Budget(opts)
     workers = max(1, min(int(opts.workers or 1), len(jobs)))
-    lock = threading.Lock()
-    waiting = {name: w for name, w, _ in jobs}
-
-    def run(name: str, fn: Callable[[SolverOptions], Plan]) -> Plan:
-        with lock:
-            total = sum(waiting.values()) or 1.0
-            share = min(1.0, workers * waiting.pop(name) / total)
-        return fn(budget.options(share))
-
+    total = sum(w for _name, w, _fn in jobs) or 1.0
+    shares = {name: budget.options(w / total) for name, w, _fn in jobs}
     if workers == 1:
-        return {name: run(name, fn) for name, _w, fn in jobs}
+        return {name: fn(shares[name]) for name, _w, fn in jobs}
     with ThreadPoolExecutor(max_workers=workers) as pool:
-        futures = {name: pool.submit(run, name, fn) for name, _w, fn in jobs}
+        futures = {name: pool.submit(fn, shares[name]) for name, _w, fn in jobs}
         return {name: f.result() for name, f in futures.items()}
 
 

@@ -38,11 +38,15 @@ def plan_cycle(network: MCNetwork, *, positions: Mapping[str, str] | None = None
     """Plan one cycle: Problem 1, then Problem 2 from where the explorers return (their
     frontiers), with the robots that received m as masters and the explorers as
     sources. ``clustering`` ("auto", True, False) splits large networks into clusters
-    (:mod:`delve.planners.cops.clustering`). ``options.total_time_limit_s`` bounds the
-    whole cycle (pre-exploration gets :data:`PRE_SHARE` of it); ``meta["gap"]`` is the
-    worst optimality gap of its integer programs (None: unknown)."""
+    (:mod:`delve.planners.cops.clustering`). ``options.total_work`` bounds the whole
+    cycle (pre-exploration gets :data:`PRE_SHARE` of it), ``options.total_time_limit_s``
+    is its safety stop; ``meta["gap"]`` is the worst optimality gap of its integer
+    programs (None: unknown), ``meta["work"]`` their simplex iterations,
+    ``meta["solves"]`` their number and ``meta["safety_stops"]`` how many safety stops
+    fired (``options.meter`` counts them too)."""
     t0 = time.perf_counter()
-    opts = options or SolverOptions()
+    budget = Budget(options or SolverOptions())
+    opts = budget.opts
     pos, st, ex = robot_sets(network, positions, static, explorers)
     ms = master_robots(network, pos, masters)
     use = should_cluster(network, pos, ms, frontiers=frontiers, static=st, explorers=ex, reward=reward) \
@@ -53,8 +57,8 @@ def plan_cycle(network: MCNetwork, *, positions: Mapping[str, str] | None = None
                                    explorers=ex, static=st, min_exploration_steps=min_exploration_steps,
                                    max_horizon=max_horizon, options=opts, **kw)
         cyc.meta["solve_time_s"] = round(time.perf_counter() - t0, 4)
+        cyc.meta.update(budget.meter.figures())
         return cyc
-    budget = Budget(opts)
     pre = solve_pre_exploration(network, positions=pos, frontiers=frontiers, masters=ms, reward=reward,
                                 explorers=ex, static=st, max_horizon=max_horizon,
                                 options=budget.options(PRE_SHARE))
@@ -66,5 +70,5 @@ def plan_cycle(network: MCNetwork, *, positions: Mapping[str, str] | None = None
     return CyclePlan(pre, post, tasks, meta={
         "clustered": False, "clusters": 1, "min_exploration_steps": min_exploration_steps,
         "solve_time_s": round(time.perf_counter() - t0, 4),
-        "gap": worst_gap([pre, post])})
+        "gap": worst_gap([pre, post]), **budget.meter.figures()})
 

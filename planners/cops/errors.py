@@ -11,4 +11,4 @@ class InfeasibleProblem(PlanningError):
 
 
 class SolverTimeout(PlanningError):
-    """The solver found no plan within its time limit."""
+    """The solver found no plan within its limits (work limits or the safety stop)."""

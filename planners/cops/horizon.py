@@ -3,7 +3,6 @@ action (solves carry a tiny cost per action and step index, :data:`TIME_WEIGHT`,
 that of equally good plans the earliest wins and a generous horizon can be cut)."""
 from __future__ import annotations
 
-import time
 from typing import Callable, Mapping
 
 from .errors import SolverTimeout
@@ -37,9 +36,10 @@ def horizon_of(traj: Mapping[str, list[str]] | None) -> int | None:
 
 
 def search_horizons(make: Callable[[int], Plan | None], lo: int, hi: int, improve: bool, patience: int,
-                    deadline: float | None) -> tuple[Plan | None, int | None]:
+                    spent: Callable[[], bool] | None = None) -> tuple[Plan | None, int | None]:
     """Solve make(T) for T = lo, lo+1, ...: the first feasible plan, then (``improve``)
-    while the objective still grows (at most ``patience`` horizons without gain)."""
+    while the objective still grows (at most ``patience`` horizons without gain), until
+    ``spent()`` says the work budget is spent."""
     best, best_T, stall = None, None, 0
     timed_out = None
     T = lo
@@ -51,7 +51,7 @@ def search_horizons(make: Callable[[int], Plan | None], lo: int, hi: int, improv
             if best is not None:
                 break
             T += 1
-            if deadline is not None and time.perf_counter() > deadline:
+            if spent is not None and spent():
                 break
             continue
         if plan is not None:
@@ -63,7 +63,7 @@ def search_horizons(make: Callable[[int], Plan | None], lo: int, hi: int, improv
                 break
         elif best is not None:
             break
-        if deadline is not None and time.perf_counter() > deadline:
+        if spent is not None and spent():
             break
         T += 1
     if best is None and timed_out is not None:

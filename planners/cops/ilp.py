@@ -16,9 +16,11 @@ per constraint family in :mod:`.ilp_constraints`), a back-end solves it
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 
 import pulp
 
+from .budget import SolveLimits
 from .errors import SolverTimeout
 from .ilp_constraints import build_model
 from .ilp_model import value
@@ -28,18 +30,18 @@ from .network import MCNetwork
 from .plan import Plan
 from .plan_extraction import extract_plan
 
-#: However long building the model took, the solver gets at least this long (s).
-MIN_SOLVER_TIME_S = 0.2
-
-
-def solve_connectivity(p: ConnectivityProblem, *, time_limit_s: float | None = None) -> Plan | None:
+def solve_connectivity(p: ConnectivityProblem, *, time_limit_s: float | None = None,
+                       limits: SolveLimits | None = None) -> Plan | None:
     """Solve ``p`` at its horizon: the plan, or None when infeasible at this horizon.
 
-    ``time_limit_s`` overrides ``p.options.time_limit_s`` for this call (building the
-    model included; the solver gets at least a fraction of a second). When the
-    limit passes with a plan in hand, that plan is returned (``meta["status"]`` is
-    "feasible" and ``meta["gap"]`` its optimality gap, None when unknown). Raises
-    :class:`SolverTimeout` when the limit passes before any plan is found.
+    The solve is bounded by ``limits`` (default: those of ``p.options``, a feasibility
+    probe's for ``p.feasibility_only``): nodes and checkpoint work, and a wall-clock
+    safety stop, which ``time_limit_s`` overrides. When a limit stops the
+    solve with a plan in hand, that plan is returned (``meta["status"]`` is
+    "feasible" and ``meta["gap"]`` its optimality gap, None when unknown);
+    ``meta["work"]`` is its simplex iterations and ``meta["stop"]`` the limit that
+    ended it. Raises :class:`SolverTimeout` when a limit stops the solve before any
+    plan is found. The work and any safety stop are counted in ``p.options.meter``.
     """
     t0 = time.perf_counter()
     for r, s in p.positions.items():
@@ -48,22 +50,27 @@ def solve_connectivity(p: ConnectivityProblem, *, time_limit_s: float | None = N
     model = build_model(p)
     if model.infeasible_reason:
         return None
-    limit = p.options.time_limit_s if time_limit_s is None else time_limit_s
-    if limit is not None:  # the limit bounds the whole call, model building included
-        limit = max(limit - (time.perf_counter() - t0), min(limit, MIN_SOLVER_TIME_S))
+    lim = limits or SolveLimits.of(p.options, probe=p.feasibility_only)
+    if time_limit_s is not None:
+        lim = replace(lim, time_limit_s=time_limit_s)
     solver_name = available_solver(p.options.solver)
     if not model.vars:
         out = Outcome("optimal", 0.0)
     elif solver_name == "highs":
-        out = solve_highs(model, p.options, limit)
+        out = solve_highs(model, p.options, lim)
     else:
-        out = solve_pulp(model, p.options, limit)
+        out = solve_pulp(model, p.options, lim)
+    if p.options.meter is not None:
+        p.options.meter.add(out.work, 1, f"{p.phase} solve at T={p.horizon} ran past its safety stop of "
+                                         f"{lim.time_limit_s:g} s" if out.safety_stop else None)
     if out.status == "infeasible":
         return None
     if out.status == "unknown":
-        if out.timed_out:
-            raise SolverTimeout(f"no plan found within the time limit of {limit:g} s (horizon T={p.horizon})")
-        return None
+        if out.safety_stop:
+            raise SolverTimeout(f"no plan found within the safety stop of {lim.time_limit_s:g} s "
+                                f"(horizon T={p.horizon})")
+        raise SolverTimeout(f"no plan found within the work limit ({_limit_text(lim, out)}, "
+                            f"horizon T={p.horizon})")
     plan = extract_plan(model)
     reward = sum(value(v) * c for v, c in _terms(model.reward_terms))
     cost = sum(value(v) * c for v, c in _terms(model.cost_terms))
@@ -76,10 +83,20 @@ def solve_connectivity(p: ConnectivityProblem, *, time_limit_s: float | None = N
         "ilp_cost": round(cost, 6),
         "solver": solver_name,
         "solve_time_s": round(time.perf_counter() - t0, 4),
+        "work": out.work,
+        "stop": out.stop,
         "variables": len(model.vars),
         "constraints": len(model.rows),
     })
     return plan
+
+
+def _limit_text(lim: SolveLimits, out: Outcome) -> str:
+    if out.stop == "work":
+        return f"{lim.max_work:g} checkpoint work"
+    if out.stop == "nodes":
+        return f"{lim.max_nodes} nodes"
+    return f"{out.stop or 'a limit'}"
 
 
 def _terms(terms: list) -> list[tuple[pulp.LpVariable, float]]:

@@ -3,37 +3,61 @@ and how it is to be solved."""
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Mapping
+from typing import TYPE_CHECKING, Mapping
 
 from .network import MCNetwork
 from .plan import Requirement
+
+if TYPE_CHECKING:
+    from .budget import Meter
 
 
 @dataclass(frozen=True)
 class SolverOptions:
     """How each integer program is solved.
 
-    ``solver``: ``"highs"``, ``"cbc"`` or None (HiGHS when installed, else CBC).
-    ``time_limit_s`` bounds every solve (the best plan found so far is returned, with
-    its optimality gap); ``mip_gap`` is the relative gap at which a solve stops;
-    ``probe_time_limit_s`` bounds each feasibility probe of the horizon search.
-    ``total_time_limit_s`` bounds one call of ``plan_cycle`` (or of
-    ``solve_pre_exploration`` / ``solve_post_exploration``): every solve's limit is
-    cut to its share of the time left, so the call returns about then with the best
-    plans found (model building and a last short solve may overrun it a little);
-    None for no bound. ``workers``: independent problems (clusters) solved at once.
-    ``stall_time_s``: a solve that holds a plan stops when the plan has not improved
-    for this long (nor for half the time it took to find it); None to disable.
+    ``solver``: ``"highs"``, ``"cbc"`` or None (HiGHS when installed, else CBC);
+    ``mip_gap`` is the relative gap at which a solve stops; ``workers``: independent
+    problems (clusters) solved at once.
+
+    **Work limits** bound every result, so that the same problem gives the same plan
+    on a quiet machine and on a busy one (:mod:`.budget`). HiGHS calls back at fixed
+    points of its search, its *checkpoints*: after presolve, after each round of cuts
+    at the root, and after each node or dive of the tree. A checkpoint counts as
+    *checkpoint work* the model's rows in thousands (at least 1): a round or a node
+    costs about that much more on a larger model. A solve stops after ``max_nodes``
+    branch-and-bound nodes or ``max_work`` checkpoint work (feasibility probes of the
+    horizon searches: ``probe_max_nodes``, ``probe_max_work``), and a solve that
+    holds a plan stops when the plan has not improved for ``stall_work`` (nor for half
+    the work it took to find it). The root LP is not cut: HiGHS calls back before and
+    after it, never during it. ``total_work`` bounds one planning call
+    (``plan_cycle``, ``solve_pre_exploration``, ``solve_post_exploration``,
+    ``solve_recall``) in simplex iterations summed over its solves: once it is spent
+    no further probe or horizon is tried, and a solve that must still run (at the
+    horizon found) gets :data:`~.budget.MIN_SOLVE_WORK`. The best plan found within
+    the limits is returned, with its optimality gap. None disables a limit.
+
+    **Safety stops** (wall clock) only guard against a machine far slower than
+    expected: ``time_limit_s`` per solve (``probe_time_limit_s`` per probe) and
+    ``total_time_limit_s`` per planning call. They are generous, and a result
+    that one of them cut short may differ from run to run: every one that fires
+    is counted (``meter``, :class:`~.budget.Meter`) and reported.
     """
 
-    time_limit_s: float | None = 30.0
     mip_gap: float | None = 0.01
     solver: str | None = None
     threads: int = 1
-    probe_time_limit_s: float | None = 5.0
-    total_time_limit_s: float | None = 10.0
     workers: int = 2
-    stall_time_s: float | None = 2.0
+    max_nodes: int | None = 500
+    max_work: float | None = 600.0
+    stall_work: float | None = 100.0
+    probe_max_nodes: int | None = 100
+    probe_max_work: float | None = 60.0
+    total_work: int | None = 12000
+    time_limit_s: float | None = 300.0
+    probe_time_limit_s: float | None = 50.0
+    total_time_limit_s: float | None = 100.0
+    meter: "Meter | None" = field(default=None, compare=False, repr=False)
 
 
 @dataclass
@@ -48,10 +72,12 @@ class ConnectivityProblem:
 
     ``warm_start`` gives trajectories (robot -> locations from t = 0, the last one
     held to T) of a plan believed feasible; the solver completes it and starts from
-    it, so a solve stopped by its time limit returns at least that plan.
+    it, so a solve stopped by its limits returns at least that plan.
     ``time_weight`` is a tiny cost per action and step index: of equally good plans
     the earliest wins, which lets a search solve once at a generous horizon and cut
-    the plan after its last action.
+    the plan after its last action. ``objective_bound`` is an upper bound on the
+    objective known without solving (e.g. from shortest paths): a completed warm
+    start within ``mip_gap`` of it is the answer, without a search.
     """
 
     network: MCNetwork
@@ -74,6 +100,7 @@ class ConnectivityProblem:
     feasibility_only: bool = False
     warm_start: Mapping[str, list[str]] | None = None
     time_weight: float = 0.0
+    objective_bound: float | None = None
 
     def holding(self, r: str) -> set[str]:
         return set(self.holdings.get(r, {r}))

@@ -1,15 +1,34 @@
 """The two solver back-ends of a built model: HiGHS fed the model as arrays, and pulp
 (CBC, or HiGHS through pulp). Both write the solution into the model's variables.
 
-HiGHS runs with presolve's probing off (it can take the whole time limit on these
-models). A warm start (trajectories, e.g. a greedy plan) is first completed with the
+HiGHS runs single-threaded with a fixed random seed and presolve's probing off (it
+can take most of a solve on these models). Its limits are counted in work
+(:class:`~.budget.SolveLimits`): branch-and-bound nodes (``mip_max_nodes``) and
+checkpoint work, counted at the calls HiGHS makes to its interrupt callback at
+fixed points of the search (after presolve, after each round of cuts at the root,
+after each node or dive), so a solve stops at the same point of its search however
+busy the machine is. HiGHS gives the callback no iteration count, and its
+``simplex_iteration_limit`` does not apply to the LPs of a MIP; the root LP runs
+to its end (it is deterministic too). Its time limit is the safety stop: a solve
+it ends is reported (``Outcome.safety_stop``).
+
+A warm start (trajectories, e.g. a greedy plan) is first completed with the
 motion fixed and then handed over as the first incumbent, so a solve stopped by its
-time limit, or because its plan has stopped improving (``SolverOptions.stall_time_s``),
-returns at least that plan, with its optimality gap.
+limits, or because its plan has stopped improving, returns at least that plan, with
+its optimality gap.
+
+CBC (through pulp, the fallback without highspy) is bounded by its node limit
+(``maxNodes``); pulp gives it no checkpoint callback, so it has no stall stop and
+its root (cuts, heuristics) is not bounded by work, and its simplex iterations are
+read from its log. CBC run single-threaded with a node limit is deterministic as
+far as we know, but that was not tested under load.
 """
 from __future__ import annotations
 
 import math
+import os
+import re
+import tempfile
 import time
 import warnings
 from collections import defaultdict
@@ -18,6 +37,7 @@ from typing import Any
 
 import pulp
 
+from .budget import SolveLimits
 from .ilp_model import ConnectivityModel
 from .ilp_problem import SolverOptions
 
@@ -45,14 +65,21 @@ def available_solver(name: str | None = None) -> str:
     return "cbc"
 
 
-def make_solver(opts: SolverOptions) -> tuple[str, Any]:
-    """The pulp solver for ``opts``: (its name, the solver)."""
+def make_solver(opts: SolverOptions, limits: SolveLimits | None = None,
+                log_path: str | None = None) -> tuple[str, Any]:
+    """The pulp solver for ``opts`` within ``limits`` (default: those of ``opts``):
+    (its name, the solver)."""
     name = available_solver(opts.solver)
-    kw = {"msg": False, "timeLimit": opts.time_limit_s, "gapRel": opts.mip_gap, "threads": opts.threads}
+    lim = limits or SolveLimits.of(opts)
+    kw = {"msg": False, "timeLimit": lim.time_limit_s, "gapRel": opts.mip_gap, "threads": opts.threads}
     if name == "highs":
         return name, pulp.HiGHS(**kw)
     if name == "highs_cmd":  # pragma: no cover - only without highspy
         return name, pulp.HiGHS_CMD(**kw)
+    if lim.max_nodes is not None:
+        kw["maxNodes"] = int(lim.max_nodes)
+    if log_path is not None:
+        kw["logPath"] = log_path
     with warnings.catch_warnings():  # the bundled CBC is the documented fallback
         warnings.simplefilter("ignore", DeprecationWarning)
         return name, pulp.PULP_CBC_CMD(**kw)
@@ -61,12 +88,27 @@ def make_solver(opts: SolverOptions) -> tuple[str, Any]:
 @dataclass
 class Outcome:
     """What one solve of a built model gave: ``status`` is "optimal", "feasible" (an
-    incumbent when the time limit passed), "infeasible" or "unknown" (no plan and no
-    proof either way, usually the time limit)."""
+    incumbent when a limit stopped the solve), "infeasible" or "unknown" (no plan and
+    no proof either way: a limit stopped the solve). ``stop`` says which limit
+    ended it ("nodes", "work", "stall", "safety"; None: it ran to its end),
+    ``work`` its simplex iterations, ``nodes`` and ``checkpoints`` its search."""
 
     status: str
     gap: float | None = None
-    timed_out: bool = False
+    stop: str | None = None
+    work: int = 0
+    nodes: int = 0
+    checkpoints: int = 0
+
+    @property
+    def safety_stop(self) -> bool:
+        """Whether the wall-clock safety stop ended the solve."""
+        return self.stop == "safety"
+
+    @property
+    def timed_out(self) -> bool:
+        """Whether a limit ended the solve before it finished."""
+        return self.stop is not None
 
 
 def warm_values(model: ConnectivityModel) -> dict[int, float] | None:
@@ -100,9 +142,10 @@ def warm_values(model: ConnectivityModel) -> dict[int, float] | None:
     return out
 
 
-def solve_highs(model: ConnectivityModel, opts: SolverOptions, time_limit: float | None) -> Outcome:
+def solve_highs(model: ConnectivityModel, opts: SolverOptions, limits: SolveLimits) -> Outcome:
     """Hand the model to HiGHS as arrays (much faster than pulp's column-by-column
-    transfer) and copy the solution back into the pulp variables."""
+    transfer), solve it within ``limits`` and copy the solution back into the pulp
+    variables."""
     import highspy
     import numpy as np
 
@@ -156,15 +199,18 @@ def solve_highs(model: ConnectivityModel, opts: SolverOptions, time_limit: float
     h.setOptionValue("random_seed", 0)
     if opts.mip_gap is not None:
         h.setOptionValue("mip_rel_gap", float(opts.mip_gap))
-    # presolve's probing can take the whole time limit on these models (HiGHS's own advice)
+    # presolve's probing can take most of a solve on these models (HiGHS's own advice)
     h.setOptionValue("presolve_rule_off", PRESOLVE_NO_PROBING)
     h.passModel(lp)
     M = highspy.HighsModelStatus
     t_start = time.perf_counter()
 
-    def remaining() -> float | None:
-        return None if time_limit is None else max(time_limit - (time.perf_counter() - t_start), 0.01)
+    def safety_left() -> float:  # the safety stop, whatever HiGHS's clock counts from
+        lim = limits.time_limit_s
+        return 1e30 if lim is None else float(max(lim - (time.perf_counter() - t_start), 0.01))
 
+    h.setOptionValue("time_limit", safety_left())
+    work = nodes = 0
     warm = warm_values(model)
     start = None
     if warm:
@@ -173,69 +219,120 @@ def solve_highs(model: ConnectivityModel, opts: SolverOptions, time_limit: float
         idx = np.fromiter(warm.keys(), dtype=np.int32, count=len(warm))
         val = np.fromiter(warm.values(), dtype=float, count=len(warm))
         h.changeColsBounds(len(warm), idx, val, val)
-        lim = remaining()
-        h.setOptionValue("time_limit", 1e30 if lim is None else float(max(0.5 * lim, 0.01)))
+        h.setOptionValue("mip_max_nodes", _int_limit(limits.max_nodes))
         h.run()
-        if h.getInfo().primal_solution_status == 2:
+        info = h.getInfo()
+        work, nodes = work + max(info.simplex_iteration_count, 0), nodes + max(info.mip_node_count, 0)
+        if h.getModelStatus() == M.kTimeLimit:
+            return Outcome("unknown", stop="safety", work=work, nodes=nodes)
+        if info.primal_solution_status == 2:
             start = list(h.getSolution().col_value)
+            bound = model.p.objective_bound
+            if bound is not None and opts.mip_gap is not None:
+                gap = (bound - info.objective_function_value) / max(abs(bound), 1e-9)
+                if gap <= opts.mip_gap:  # good enough: no search
+                    for v, x in zip(cols, start):
+                        v.varValue = x
+                    return Outcome("optimal", max(gap, 0.0), work=work, nodes=nodes)
         h.changeColsBounds(len(warm), idx, col_lower[idx], col_upper[idx])
-    lim = remaining()
-    h.setOptionValue("time_limit", 1e30 if lim is None else float(lim))
+    h.setOptionValue("mip_max_nodes", _int_limit(limits.max_nodes))
+    h.setOptionValue("time_limit", safety_left())
     if start is not None:
         sol = highspy.HighsSolution()
         sol.col_value = start
         sol.value_valid = True
         h.setSolution(sol)
-    stall = opts.stall_time_s if not model.p.feasibility_only else None
-    if stall:
-        last = [time.perf_counter() if start is not None else None]
+    stall = limits.stall_work if not model.p.feasibility_only else None
+    max_work = limits.max_work
+    weight = checkpoint_weight(len(model.rows))
+    # checkpoints, their work, work at the last improvement (None: no plan yet), why it stopped
+    state = {"n": 0, "work": 0.0, "last": 0.0 if start is not None else None, "stop": None}
 
-        def improved(_event) -> None:
-            last[0] = time.perf_counter()
+    def improved(_event) -> None:
+        state["last"] = state["work"]
 
-        def check(event) -> None:
-            t = last[0]
-            if t is not None and time.perf_counter() - t > max(stall, 0.5 * (t - t_start)):
-                event.interrupt()
+    def check(event) -> None:
+        state["n"] += 1
+        state["work"] += weight
+        w, last = state["work"], state["last"]
+        if max_work is not None and w >= max_work:
+            state["stop"] = "work"
+            event.interrupt()
+        elif stall and last is not None and w - last >= max(stall, 0.5 * last):
+            state["stop"] = "stall"
+            event.interrupt()
 
-        h.cbMipImprovingSolution.subscribe(improved)
-        h.cbMipInterrupt.subscribe(check)
-        h.cbSimplexInterrupt.subscribe(check)
+    h.cbMipImprovingSolution.subscribe(improved)
+    h.cbMipInterrupt.subscribe(check)
     h.run()
     status = h.getModelStatus()
     info = h.getInfo()
+    work, nodes = work + max(info.simplex_iteration_count, 0), nodes + max(info.mip_node_count, 0)
+    stop = {M.kTimeLimit: "safety", M.kInterrupt: state["stop"]}.get(status)
+    if stop is None and status not in (M.kOptimal, M.kInfeasible, M.kUnboundedOrInfeasible):
+        stop = "nodes"  # node limit (HiGHS reports an iteration or solution limit)
+    done = {"work": work, "nodes": nodes, "checkpoints": state["n"], "stop": stop}
     if status in (M.kInfeasible, M.kUnboundedOrInfeasible):
-        return Outcome("infeasible")
+        return Outcome("infeasible", **done)
     values = None
     gap = float(info.mip_gap) if math.isfinite(info.mip_gap) else None
     if info.primal_solution_status == 2:
         values = h.getSolution().col_value
-    elif start is not None:  # nothing better than the completed warm start in time
-        values, gap, status = start, None, M.kTimeLimit
+    elif start is not None:  # nothing better than the completed warm start
+        values, gap = start, None
     if values is None:
-        return Outcome("unknown", timed_out=status == M.kTimeLimit)
+        return Outcome("unknown", **done)
     for v, x in zip(cols, values):
         v.varValue = x
     if status == M.kOptimal:
-        return Outcome("optimal", 0.0 if gap is None else gap)
-    return Outcome("feasible", gap, timed_out=status == M.kTimeLimit)
+        return Outcome("optimal", 0.0 if gap is None else gap, **done)
+    return Outcome("feasible", gap, **done)
 
 
-def solve_pulp(model: ConnectivityModel, opts: SolverOptions, time_limit: float | None) -> Outcome:
-    """Hand the model to a pulp solver (CBC, or HiGHS's command line) row by row."""
-    o = SolverOptions(time_limit_s=time_limit, mip_gap=opts.mip_gap, solver=opts.solver, threads=opts.threads)
-    _name, solver = make_solver(o)
+def checkpoint_weight(rows: int) -> float:
+    """The work of one checkpoint of a model with ``rows`` rows: its rows in thousands,
+    at least 1 (a round of cuts or a node costs about that much more on a larger model)."""
+    return max(1.0, rows / 1000.0)
+
+
+def _int_limit(n: int | None) -> int:
+    """A HiGHS integer limit (its default, 2^31 - 1, for none)."""
+    return 2147483647 if n is None else int(n)
+
+
+def solve_pulp(model: ConnectivityModel, opts: SolverOptions, limits: SolveLimits) -> Outcome:
+    """Hand the model to a pulp solver (CBC, or HiGHS's command line) row by row,
+    within ``limits`` (CBC: its node limit and the safety stop)."""
     for row in model.rows:
         model.lp += row
     model.lp += model.objective
-    t0 = time.perf_counter()
-    model.lp.solve(solver)
+    fd, log_path = tempfile.mkstemp(prefix="cops_cbc_", suffix=".log")
+    os.close(fd)
+    try:
+        _name, solver = make_solver(opts, limits, log_path)
+        model.lp.solve(solver)
+        with open(log_path, errors="replace") as f:
+            log = f.read()
+    finally:
+        os.unlink(log_path)
+    work, nodes, stop = _cbc_figures(log)
     status, sol_status = model.lp.status, model.lp.sol_status
+    done = {"work": work, "nodes": nodes, "stop": stop}
     if sol_status == pulp.LpSolutionInfeasible or status == pulp.LpStatusInfeasible:
-        return Outcome("infeasible")
+        return Outcome("infeasible", **done)
     if sol_status == pulp.LpSolutionOptimal:
-        return Outcome("optimal", 0.0)
-    timed_out = time_limit is not None and time.perf_counter() - t0 >= 0.9 * time_limit
+        return Outcome("optimal", 0.0, **done)
+    if stop is None:
+        stop = done["stop"] = "nodes"
     if sol_status == pulp.LpSolutionIntegerFeasible:
-        return Outcome("feasible", None, timed_out)
-    return Outcome("unknown", timed_out=timed_out)
+        return Outcome("feasible", None, **done)
+    return Outcome("unknown", **done)
+
+
+def _cbc_figures(log: str) -> tuple[int, int, str | None]:
+    """Simplex iterations, nodes and the limit that stopped CBC, from its log."""
+    its = re.findall(r"Total iterations:\s*(\d+)", log)
+    nodes = re.findall(r"Enumerated nodes:\s*(\d+)", log)
+    stop = "safety" if re.search(r"Result - Stopped on time", log) else \
+        "nodes" if re.search(r"Result - Stopped on (nodes|iterations|solutions)", log) else None
+    return (int(its[-1]) if its else 0), (int(nodes[-1]) if nodes else 0), stop

@@ -3,8 +3,8 @@ station (or another sink) receives the information of every source robot, at lea
 cost.
 
 The horizon is bounded by a greedy plan; feasibility probes bisect below it while
-time allows, and the least-cost plan is solved at the smallest horizon found
-feasible, warm-started, then cut after its last action.
+the call's work budget lasts, and the least-cost plan is solved at the smallest
+horizon found feasible, warm-started, then cut after its last action.
 """
 from __future__ import annotations
 
@@ -14,7 +14,7 @@ from typing import Callable, Iterable, Mapping
 
 import networkx as nx
 
-from .budget import MIN_SOLVE_TIME_S, Budget
+from .budget import Budget
 from .distances import information_distance, m_distance
 from .errors import InfeasibleProblem, SolverTimeout
 from .greedy import greedy_post_plan
@@ -24,6 +24,10 @@ from .ilp_problem import ConnectivityProblem, SolverOptions
 from .network import MCNetwork
 from .plan import Plan, Requirement, idle_plan
 from .roles import master_robots, robot_sets
+
+#: Work (simplex iterations) that must be left of the budget for another probe of the
+#: bisection to start; the least-cost solve at the horizon found gets the rest.
+PROBE_RESERVE = 2000
 
 
 def solve_post_exploration(network: MCNetwork, *, sources: Iterable[str], positions: Mapping[str, str] | None = None,
@@ -40,8 +44,8 @@ def solve_post_exploration(network: MCNetwork, *, sources: Iterable[str], positi
     (R_f), at least cost C(Π).
 
     Without ``horizon`` the horizon is bounded by a greedy plan
-    (:func:`greedy_post_plan`); feasibility probes (each within
-    ``probe_time_limit_s``) bisect below it while time allows, and the least-cost
+    (:func:`greedy_post_plan`); feasibility probes (each within the probe limits of
+    ``options``) bisect below it while the work budget lasts, and the least-cost
     plan is solved at the smallest horizon found feasible, warm-started, then cut
     after its last action. Without a greedy plan the smallest feasible T is searched
     from a lower bound up to ``max_horizon``. Raises :class:`InfeasibleProblem` naming
@@ -106,10 +110,9 @@ def solve_post_exploration(network: MCNetwork, *, sources: Iterable[str], positi
     final = {} if sink_final_location is None else {base: sink_final_location}
 
     def make(T: int, sub: list[str] | None = None, probe: bool = False,
-             warm: Mapping[str, list[str]] | None = None, tw: float = 0.0,
-             limit: float | None = None) -> Plan | None:
+             warm: Mapping[str, list[str]] | None = None, tw: float = 0.0) -> Plan | None:
         q = req if sub is None else [Requirement(tuple(sub), (base,))]
-        o = replace(opts, mip_gap=None) if probe else opts
+        o = replace(budget.opts, mip_gap=None) if probe else budget.opts
         if warm is not None and horizon_of(warm) > T:
             warm = None
         return solve_connectivity(ConnectivityProblem(
@@ -117,7 +120,7 @@ def solve_post_exploration(network: MCNetwork, *, sources: Iterable[str], positi
             holdings=hold, requirements=q, final_positions=final,
             collision_robots=col_r, collision_locations=col_s,
             phase=phase, options=o, feasibility_only=probe, warm_start=warm, time_weight=tw),
-            time_limit_s=(budget.limit(probe=probe) if limit is None else limit))
+            limits=budget.limits(probe=probe))
 
     if horizon is not None:
         plan = make(horizon, warm=greedy)
@@ -127,21 +130,21 @@ def solve_post_exploration(network: MCNetwork, *, sources: Iterable[str], positi
 
     def probe(T: int) -> Plan | None:
         try:
-            return make(T, probe=True, limit=budget.limit(share=0.25, probe=True))
+            return make(T, probe=True)
         except SolverTimeout:
             return None
 
     lo = int(max(lower, 0))
     if greedy is not None and T_h <= hi:
-        # bisect below the greedy horizon with feasibility probes while time allows,
-        # then the least-cost plan at the best horizon, warm-started
+        # bisect below the greedy horizon with feasibility probes while the work budget
+        # lasts, then the least-cost plan at the best horizon, warm-started
         best_T, bad, warm = T_h, lo - 1, greedy
-        while best_T - bad > 1 and (budget.left() is None or budget.left() > 4 * MIN_SOLVE_TIME_S):
+        while best_T - bad > 1 and not budget.spent(PROBE_RESERVE):
             mid = (best_T + bad) // 2
             try:
-                found = make(mid, probe=True, limit=budget.limit(share=0.25, probe=True))
+                found = make(mid, probe=True)
             except SolverTimeout:
-                break  # too hard to tell in time: larger horizons are harder still
+                break  # too hard to tell within the probe's limits: larger horizons are harder still
             if found is None:
                 bad = mid
             else:
@@ -165,17 +168,17 @@ def solve_post_exploration(network: MCNetwork, *, sources: Iterable[str], positi
     carry_home = max(carry_home, lo)
     T = int(min(max(carry_home, lo), hi)) if carry_home < math.inf else hi
     found = probe(T)
-    while found is None and T < hi and (budget.left() is None or budget.left() > MIN_SOLVE_TIME_S):
+    while found is None and T < hi and not budget.spent():
         T += 1
         found = probe(T)
     if found is None:
-        # probes may have timed out: one full solve at the largest horizon decides
-        found = make(hi)  # raises SolverTimeout when even that finds nothing in time
+        # probes may have stopped at their limits: one full solve at the largest horizon decides
+        found = make(hi)  # raises SolverTimeout when even that finds nothing within its limits
         if found is None:
             raise InfeasibleProblem(_diagnose_post(make, srcs, bounds, hi))
         return found
     best_T, bad = T, lo - 1
-    while best_T - bad > 1 and (budget.left() is None or budget.left() > 4 * MIN_SOLVE_TIME_S):
+    while best_T - bad > 1 and not budget.spent(PROBE_RESERVE):
         mid = (best_T + bad) // 2
         attempt = probe(mid)
         if attempt is None:

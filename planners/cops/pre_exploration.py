@@ -3,7 +3,7 @@ the frontiers, maximising the frontier rewards minus the plan's cost.
 
 The horizon comes from a greedy plan (an upper bound), at which one integer program
 is solved warm-started from it, with a tiny cost on late actions; the best plan
-found within the time limit is cut after its last action. The solver's answer is
+found within the solve's work limits is cut after its last action. The solver's answer is
 never worse than the greedy plan.
 """
 from __future__ import annotations
@@ -105,15 +105,14 @@ def solve_pre_exploration(network: MCNetwork, *, positions: Mapping[str, str] | 
     hi = max_horizon if max_horizon is not None else max(lower + 2 * horizon_patience + 2, len(network),
                                                          (T_h or 0) + horizon_patience)
 
-    def make(T: int, warm: Mapping[str, list[str]] | None = None, tw: float = 0.0,
-             limit: float | None = None) -> Plan | None:
+    def make(T: int, warm: Mapping[str, list[str]] | None = None, tw: float = 0.0) -> Plan | None:
         if warm is not None and horizon_of(warm) > T:
             warm = None
         return solve_connectivity(ConnectivityProblem(
             network=network, horizon=T, positions=pos, masters=ms, static=st, explorers=ex,
             location_rewards=rewards, frontiers=set(fr), master_sinks=set(sinks),
-            collision_robots=col_r, collision_locations=col_s, phase=phase, options=opts,
-            warm_start=warm, time_weight=tw), time_limit_s=budget.limit() if limit is None else limit)
+            collision_robots=col_r, collision_locations=col_s, phase=phase, options=budget.opts,
+            warm_start=warm, time_weight=tw), limits=budget.limits())
 
     if horizon is not None:
         plan = make(horizon, greedy)
@@ -125,9 +124,8 @@ def solve_pre_exploration(network: MCNetwork, *, positions: Mapping[str, str] | 
         plan = make(T, greedy, TIME_WEIGHT)
         if plan is not None:
             return trim_plan(plan)
-    deadline = None if budget.end is None else budget.end
     plan, _ = search_horizons(lambda T: make(T), max(lower, 1), max(hi, lower, 1), True, horizon_patience,
-                              deadline)
+                              budget.spent)
     if plan is None:
         raise InfeasibleProblem(f"no information-consistent pre-exploration plan within horizon T={hi}")
     return plan

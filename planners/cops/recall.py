@@ -6,13 +6,19 @@ It is a reward problem like Problem 1: each robot holding m at the base at T ear
 ``home_reward``, minus the plan's cost C(Π). The horizon grows from the farthest
 robot's distance until every robot gets home or two longer horizons bring no more;
 the greedy plan of Problem 1 with the base as the only rewarded place (couriers
-bring m, robots walk home) warm-starts each solve, so a solve stopped by its time
-limit is never worse than that.
+bring m, robots walk home) warm-starts each solve, so a solve stopped by its limits
+is never worse than that. When that plan is within the solver's gap of an upper
+bound (every robot's reward less its cheapest way home) it is taken without a
+search. ``options.total_work`` bounds the search over horizons.
 """
 from __future__ import annotations
 
+import math
 from typing import Iterable, Mapping
 
+import networkx as nx
+
+from .budget import Budget
 from .errors import InfeasibleProblem, SolverTimeout
 from .greedy import greedy_pre_plan
 from .horizon import horizon_of
@@ -29,7 +35,8 @@ def solve_recall(network: MCNetwork, *, positions: Mapping[str, str], masters: I
                  static: Iterable[str] = (), max_horizon: int | None = None,
                  home_reward: float = DEFAULT_HOME_REWARD, options: SolverOptions | None = None) -> Plan:
     """An information-consistent plan that brings home every robot m can reach, at
-    least cost; ``plan.meta["stranded"]`` lists the robots it cannot reach."""
+    least cost; ``plan.meta["stranded"]`` lists the robots it cannot reach. Its
+    horizons grow while ``options.total_work`` lasts (the first is always solved)."""
     base = network.base
     if base is None:
         raise ValueError("the recall needs a base location")
@@ -46,18 +53,23 @@ def solve_recall(network: MCNetwork, *, positions: Mapping[str, str], masters: I
         if positions[r] not in hops:
             raise InfeasibleProblem(f"no route to the base for robot {r}")
     upper = max_horizon if max_horizon is not None else 2 * max(hops[positions[r]] for r in away) + 2
-    opts = options or SolverOptions()
+    budget = Budget(options or SolverOptions())
     rewards = {base: (home_reward,) * len(mobile)}
     greedy = greedy_pre_plan(network, positions, ms, st, mobile, rewards)
     T_greedy = horizon_of(greedy)
+
+    # no plan earns more than each robot's reward less its cheapest way home
+    to_base = nx.single_source_dijkstra_path_length(network.mobility.reverse(copy=False), base, weight="cost")
+    bound = sum(max(home_reward - to_base.get(positions[r], math.inf), 0.0) for r in mobile)
 
     def solve(T: int) -> Plan | None:
         warm = greedy if T_greedy is not None and T_greedy <= T else None
         problem = ConnectivityProblem(network=network, horizon=T, positions=dict(positions), masters=ms, static=st,
                                       explorers=set(mobile), reward_robots=set(mobile), location_rewards=rewards,
-                                      phase="recall", options=opts, warm_start=warm)
+                                      phase="recall", options=budget.opts, warm_start=warm,
+                                      objective_bound=bound)
         try:
-            return solve_connectivity(problem)
+            return solve_connectivity(problem, limits=budget.limits())
         except SolverTimeout:
             return None
 
@@ -74,11 +86,12 @@ def solve_recall(network: MCNetwork, *, positions: Mapping[str, str], masters: I
             best, stalled = plan, 0
         else:
             stalled += 1
-        if home(best) == len(mobile) or stalled >= 2:
+        if home(best) == len(mobile) or stalled >= 2 or budget.spent():
             break
     if best is None:
         raise InfeasibleProblem(f"no recall plan within horizon T={upper}")
     hand_m_at_base(best, base, mobile)
+    best.meta.update(budget.meter.figures())
     best.meta["stranded"] = sorted(r for r in mobile if best.location(r, best.horizon) != base)
     best.explore = {}
     return best
@@ -86,7 +99,7 @@ def solve_recall(network: MCNetwork, *, positions: Mapping[str, str], masters: I
 
 def hand_m_at_base(plan: Plan, base: str, mobile: list[str]) -> None:
     """Robots at the base at T that m has not reached get it there at T (a solve
-    stopped by its time limit may leave out such a reward)."""
+    stopped by its limits may leave out such a reward)."""
     T, holders = plan.horizon, plan.master_receivers()
     giver = next((h for h in sorted(holders) if plan.location(h, T) == base), None)
     if giver is None:

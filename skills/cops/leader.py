@@ -11,6 +11,7 @@ from py_trees.common import Status
 
 from ...planners.cops import (MASTER, CyclePlan, PlanningError, SolverOptions, plan_cycle,
                               solve_post_exploration, validate_plan)
+from ...planners.cops.budget import Meter
 from ...planners.cops.plan import idle_plan
 from ...planners.cops.recall import solve_recall
 from ...planners.cops.topology import Topology, team_network
@@ -43,6 +44,10 @@ class SolveCOPS(CopsSkill):
     before the recall's m reaches them (logged ``cops_replan_returning``). Every
     plan is checked with the plan validator before it is used.
 
+    Solves are bounded by work limits (``SolverOptions``), so the plans do not
+    depend on the machine's load; ``time_limit_s`` is only a safety stop, and each
+    one that fires while planning is logged (``cops_safety_stop``).
+
     Reads services ``team`` (robot -> start location) and ``base_location``.
     Writes ``cops`` (plan, cycle, part = pre, step = 0). Logs ``cops_plan``.
     Returns SUCCESS with a plan, FAILURE when no plan exists (logged with the reason).
@@ -55,13 +60,15 @@ class SolveCOPS(CopsSkill):
         "min_exploration_steps": Param(int, 4, "exploration time of a cycle, in steps of ΔT", minimum=1),
         "lost_timeout_s": Param(float, 1200.0, "silence after which a partner is declared lost",
                                 exclusive_minimum=0),
-        "time_limit_s": Param(float, 10.0, "time limit of each integer program (wall clock)",
-                              exclusive_minimum=0),
+        "time_limit_s": Param(float, 100.0, "safety stop of each integer program (wall clock; plans are "
+                              "bounded by work limits, and a safety stop that fires is logged, "
+                              "cops_safety_stop)", exclusive_minimum=0),
         "spacing_m": Param(float, 50.0, "location spacing: a move's cost is its length over this",
                            exclusive_minimum=0),
         "recall_after_s": Param(float, 1800.0, "standing order of m: a robot that receives no new plan "
                                 "this long after its part goes back to the base", exclusive_minimum=0),
     }
+    _meter: Meter | None = None  # work and safety stops of the planning in progress
 
     def update(self) -> Status:
         st = self.state
@@ -69,6 +76,7 @@ class SolveCOPS(CopsSkill):
         team = self.ctx.services["team"]
         kn = st.knowledge
         positions, returning = self._positions(st, team)
+        meter = self._meter = Meter()
         try:
             net, cyc = self._plan(st, positions, returning)
             gone = set() if net.frontiers or cyc.meta["owed"] else self._gone_before_m(st, cyc)
@@ -83,9 +91,11 @@ class SolveCOPS(CopsSkill):
             cyc.meta["explored"] = sorted(kn.topology.explored)
             cyc.meta["returning"] = returning
         except (PlanningError, ValueError) as err:
+            self._safety_stops(st, meter)
             self.event("cops_no_plan", cycle=st.cycle + 1, reason=str(err))
             self.feedback_message = str(err)
             return Status.FAILURE
+        self._safety_stops(st, meter)
         problems = validate_plan(net, cyc.pre) + validate_plan(net.with_positions(cyc.pre.final_positions()), cyc.post)
         if problems:
             self.event("cops_invalid_plan", cycle=st.cycle + 1, reason=str(problems[0]))
@@ -105,7 +115,7 @@ class SolveCOPS(CopsSkill):
                    transitions=sum(p.moves(r) for p in (cyc.pre, cyc.post) for r in p.robots),
                    relayed=sum(1 for p in (cyc.pre, cyc.post) for c in p.communications
                                if c.info not in (c.sender, MASTER)),
-                   solve_time_s=cyc.meta.get("solve_time_s"), gap=cyc.meta.get("gap"),
+                   solve_time_s=cyc.meta.get("solve_time_s"), work=meter.work, gap=cyc.meta.get("gap"),
                    clustered=bool(cyc.meta.get("clustered")), valid=True)
         return Status.SUCCESS
 
@@ -131,7 +141,7 @@ class SolveCOPS(CopsSkill):
         kn = st.knowledge
         net = team_network(kn.topology, st.base_location, self.ctx.name, positions, spacing_m=self.p["spacing_m"])
         positions = net.positions()
-        opts = SolverOptions(time_limit_s=self.p["time_limit_s"])
+        opts = SolverOptions(time_limit_s=self.p["time_limit_s"], meter=self._meter)
         owed = {r for r in positions if st.explored_in.get(r, -1) > kn.freshness.get(r, -1)}
         plan = self._cycle if net.frontiers else self._recall
         static = {self.ctx.name, *returning}
@@ -140,6 +150,13 @@ class SolveCOPS(CopsSkill):
         cyc = plan(net, positions, owed, static, opts)
         cyc.meta["owed"] = sorted(owed)
         return net, cyc
+
+    def _safety_stops(self, st: CopsState, meter: Meter) -> None:
+        """Log the safety stops that fired while planning the next cycle: its plan may
+        differ from run to run."""
+        if meter.safety_stops:
+            self.event("cops_safety_stop", cycle=st.cycle + 1, count=len(meter.safety_stops),
+                       reasons=meter.safety_stops)
 
     def _gone_before_m(self, st: CopsState, cyc: CyclePlan) -> set[str]:
         """Robots away from the base whose standing order of m will have sent them home
@@ -176,7 +193,7 @@ class SolveCOPS(CopsSkill):
                   min_exploration_steps=self.p["min_exploration_steps"], options=opts)
         try:
             cyc = plan_cycle(net, **kw)
-        except PlanningError as err:  # too hard within the time limit: the nearest frontier only
+        except PlanningError as err:  # too hard within the limits: the nearest frontier only
             hops = net.hop_distances(net.base)
             nearest = min(net.frontiers, key=lambda s: (hops.get(s, math.inf), s))
             self.event("cops_fallback", reason=str(err), frontier=nearest)
