@@ -103,8 +103,8 @@ def read_geometry(path: str | Path) -> Geometry:
         if suffix == ".ply" and not _ply_has_faces(path):
             return _read_points(path)
         mesh = read_mesh(path)
-        return Geometry(np.asarray(mesh.vertices, dtype=np.float64), np.asarray(mesh.triangles, dtype=np.int32),
-                        suffix.lstrip(".").upper(), mesh=mesh)
+        return Geometry(np.asarray(mesh.vertices, dtype=np.float64),
+                        np.asarray(mesh.triangles, dtype=np.int32), suffix.lstrip(".").upper(), mesh=mesh)
     return _read_points(path)
 
 
@@ -191,8 +191,8 @@ def _read_points(path: Path) -> Geometry:
 def read_sdf_model(path: Path) -> Geometry:
     """The collision meshes of a Gazebo model (SDF), each with its ``<scale>`` and the
     ``<pose>`` of its link and collision, as one mesh in the model's frame: z up, and
-    a Collada mesh's ``<up_axis>`` ignored, as Gazebo places it. ``model://NAME/...`` URIs resolve against the model folder and
-    its siblings; a world SDF's ``<include>``s are not followed."""
+    a Collada mesh's ``<up_axis>`` ignored, as Gazebo places it. ``model://NAME/...``
+    URIs resolve against the model folder and its siblings; a world SDF's ``<include>``s are not followed."""
     try:
         root = ET.parse(path).getroot()
     except (ET.ParseError, OSError) as err:
@@ -220,8 +220,8 @@ def read_sdf_model(path: Path) -> Geometry:
     if not parts_v:
         raise ValueError(f"SDF file '{path.name}': no <collision> with a <mesh> in it (delve reads a model's "
                          f"collision meshes; a world's <include>s are not followed)")
-    return Geometry(np.concatenate(parts_v), np.concatenate(parts_t).astype(np.int32), "Gazebo SDF", up_axis="z",
-                    unit_m=1.0)
+    return Geometry(np.concatenate(parts_v), np.concatenate(parts_t).astype(np.int32), "Gazebo SDF",
+                    up_axis="z", unit_m=1.0)
 
 
 def _sdf_pose(el: ET.Element | None) -> np.ndarray:

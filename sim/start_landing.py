@@ -62,13 +62,14 @@ def land(world: "World", point: np.ndarray, *, aerial: bool, body_height_m: floa
             return out
         clear = clearance_m(world, body, radius_m)
         if clear < radius_m:
-            out.warnings.append(f"hovers {clear:.2f} m from rock at its start, within its radius of {radius_m:g} m")
+            out.warnings.append(f"hovers {clear:.2f} m from rock at its start, within its radius of "
+                                f"{radius_m:g} m")
         out.start = p
     else:
         out.start = _on_floor(world, p, max_drop_m)
         if out.start is None:
-            out.problem = (f"{max_drop_m:g} m or more above the floor (a legged robot's start is placed on the "
-                           f"floor below it, at most {max_drop_m:g} m down){world.nearest_floor_hint(p)}")
+            out.problem = (f"{max_drop_m:g} m or more above the floor (a legged robot's start is placed on "
+                           f"the floor below it, at most {max_drop_m:g} m down){world.nearest_floor_hint(p)}")
             return out
         out.moved_m = float(p[2] - out.start[2])
     _check_region(world, out)

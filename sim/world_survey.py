@@ -94,14 +94,15 @@ def world_warnings(world: World, figures: Survey) -> list[WorldWarning]:
     if share < SPARSE_SHARE:
         out.append(WorldWarning("mesh" if src else None,
                                 f"free volume {figures.free_volume_m3:.1f} m³ is {share:.3%} of the "
-                                f"{ext[0]:.0f} × {ext[1]:.0f} × {ext[2]:.0f} m bounding box: is the model read as "
-                                f"it is meant (up axis, scale, which side of its surface is air)?"))
+                                f"{ext[0]:.0f} × {ext[1]:.0f} × {ext[2]:.0f} m bounding box: is the model "
+                                f"read as it is meant (up axis, scale, which side of its surface is air)?"))
     if src is not None and src.closure in ("open", "solids"):
         what = (f"is open ({src.boundary_edges} boundary edges)" if src.closure == "open" else
                 "encloses solids, not passages (its faces turn outwards, as a Gazebo model of boxes)")
-        ceiling = f"{'ceiling_m' if src.ceiling_from == 'scenario' else 'the model top'}, z = {src.ceiling_z:.1f} m"
-        out.append(WorldWarning("mesh", f"the mesh {what}: free space was built from its surface: rock where it "
-                                        f"passes, a ceiling at {ceiling}, the floored regions under it"))
+        by = "ceiling_m" if src.ceiling_from == "scenario" else "the model top"
+        out.append(WorldWarning("mesh", f"the mesh {what}: free space was built from its surface: rock "
+                                        f"where it passes, a ceiling at {by}, z = {src.ceiling_z:.1f} m, the "
+                                        f"floored regions under it"))
     regions = figures.significant_regions
     if len(regions) > 1:
         listed = ", ".join(f"{r:.0f}" for r in regions[:4]) + (", ..." if len(regions) > 4 else "")

@@ -80,8 +80,8 @@ def from_file(path: str | Path, *, scale: float | None = None, up_axis: str | No
     points = [list(start)] if start is not None else []
     points += [list(s) for s in seeds]
     if geo.is_points:
-        world = _points_world(geo, verts, v, name, src, ceiling_m, scan_origins, trajectory, inflation_m, points,
-                              rot, factor, path)
+        world = _points_world(geo, verts, v, name, src, ceiling_m, scan_origins, trajectory, inflation_m,
+                              points, rot, factor, path)
     else:
         world = _mesh_world(geo, verts, v, name, src, ceiling_m, points)
     if start is not None:
@@ -166,8 +166,12 @@ def _points_world(geo: Geometry, verts: np.ndarray, v: float, name: str, src: di
 
 def _voxel_world(free: np.ndarray, origin: np.ndarray, v: float, name: str, source: WorldSource) -> World:
     if not free.any():
+        ext = np.asarray(free.shape) * v
+        how = {"scenario": "from up_axis", "file": "from the file's header", "default": "by default"}
         raise ValueError(f"world file '{source.file}' gives no free space: no region under the ceiling "
-                         f"(z = {source.ceiling_z:.1f} m) has a floor below it")
+                         f"(z = {source.ceiling_z:.1f} m) has a floor below it; the model is {ext[0]:.1f} × "
+                         f"{ext[1]:.1f} × {ext[2]:.1f} m read with up axis {source.up_axis} "
+                         f"{how[source.up_axis_from]}: is that the axis that points up?")
     return World(name=name, voxel_size_m=v, origin=origin, free=free, mesh=free_space_mesh(free, origin, v),
                  centreline=nx.Graph(), start=np.zeros(3), source=source)
 
@@ -181,10 +185,11 @@ def read_trajectory(path: Path) -> np.ndarray:
     if path.suffix.lower() in (".npy", ".pcd", ".ply"):
         return read_geometry(path).vertices
     try:
-        rows = np.loadtxt(path, comments="#", delimiter=None if path.suffix.lower() != ".csv" else ",", ndmin=2)
+        delimiter = "," if path.suffix.lower() == ".csv" else None
+        rows = np.loadtxt(path, comments="#", delimiter=delimiter, ndmin=2)
     except ValueError:
-        raise ValueError(f"cannot read trajectory '{path.name}': lines of numbers x y z (or t x y z qx qy qz qw) "
-                         f"expected") from None
+        raise ValueError(f"cannot read trajectory '{path.name}': lines of numbers x y z (or t x y z qx qy qz "
+                         f"qw) expected") from None
     if rows.shape[1] < 3:
         raise ValueError(f"cannot read trajectory '{path.name}': fewer than 3 numbers a line")
     return rows[:, 1:4] if rows.shape[1] == 8 else rows[:, :3]

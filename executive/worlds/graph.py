@@ -18,7 +18,8 @@ from ...skills.base import AgentContext, short_repr
 from ..errors import DelveError
 from ..yamlio import YamlDict, file_problem, line_of_key_named
 from . import graph_sources
-from .base import BASE, Coverage, TeamNetwork, WorldBackend, only_keys
+from .base import BASE, Coverage, TeamNetwork, WorldBackend, WorldDescription, only_keys
+from .graph_check import describe_graph_world
 from .graph_plot import plot_graph_map
 
 if TYPE_CHECKING:
@@ -80,6 +81,10 @@ class GraphBackend(WorldBackend):
         except ValueError as err:
             where = scenario.doc["world"]
             raise DelveError(f"world: {err}", scenario.path, line_of_key_named(where, str(err)) or where.line) from None
+
+    @classmethod
+    def describe(cls, scenario: "Scenario", world: GraphWorld) -> WorldDescription:
+        return describe_graph_world(scenario, world)
 
     # ---- a mission ----------------------------------------------------------------
     def __init__(self, scenario: "Scenario", world: GraphWorld, seed: int, clock: SimClock):

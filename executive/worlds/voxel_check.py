@@ -60,8 +60,9 @@ def place_starts(scenario: "Scenario", world: World) -> list[StartPlacement]:
         line = spec.start_line if spec.start is not None else spec.line
         error = None
         if landing.problem:
-            error = DelveError(f"robot {short_repr(spec.name)}: start pose {_xyz(point)} is "
-                               f"{landing.problem}", scenario.path, line)
+            shown = spec.start if spec.start is not None else _xyz(point)      # as check_starts shows it
+            error = DelveError(f"robot {short_repr(spec.name)}: start pose {shown} is {landing.problem}",
+                               scenario.path, line)
         out.append(StartPlacement(spec.name, spec.platform, spec.start is not None, landing, line, error))
     return out
 
