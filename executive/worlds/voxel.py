@@ -17,11 +17,11 @@ from ...sim.robot import SimRobot
 from ...sim.voxel_map import UNKNOWN, VoxelMap
 from ...sim.world import World
 from ...sim.worldfile import from_file
-from ...skills.base import AgentContext
+from ...skills.base import AgentContext, short_repr
 from ...skills.cops.voxel_view import VoxelNetworkView
 from ...skills.navigation import navigator
 from ..errors import DelveError
-from ..yamlio import YamlDict, line_of_key_named
+from ..yamlio import YamlDict, file_problem, line_of_key_named
 from .base import BASE, Coverage, TeamNetwork, WorldBackend, WorldDescription, only_keys
 from .voxel_check import describe_voxel_world, place_starts
 from .voxel_plot import plot_voxel_map
@@ -64,16 +64,20 @@ class VoxelBackend(WorldBackend):
         spec, where = dict(scenario.world), scenario.doc["world"]
         try:
             if "mesh" in spec:
-                mesh = (scenario.path.parent / spec.pop("mesh")).resolve()
-                if not mesh.exists():
-                    raise DelveError(f"mesh file not found: {mesh}", scenario.path, where.key_line("mesh"))
+                given = scenario.path.parent / spec.pop("mesh")
+                problem = file_problem(given)
+                if problem and problem != "is a directory":  # a folder: a Gazebo model
+                    raise DelveError(f"mesh file {problem}: {short_repr(str(given))[1:-1]}", scenario.path,
+                                     where.key_line("mesh"))
+                mesh = given.resolve()
                 spec.pop("seed", None)
                 if "trajectory" in spec:
                     given = spec["trajectory"]
-                    spec["trajectory"] = (scenario.path.parent / given).resolve()
-                    if not spec["trajectory"].is_file():
-                        raise DelveError(f"trajectory file not found: {given}", scenario.path,
+                    problem = file_problem(scenario.path.parent / given)
+                    if problem:
+                        raise DelveError(f"trajectory file {problem}: {short_repr(given)[1:-1]}", scenario.path,
                                          where.key_line("trajectory"))
+                    spec["trajectory"] = (scenario.path.parent / given).resolve()
                 seeds = [r.start for r in scenario.robots if r.start is not None]
                 return from_file(mesh, seeds=seeds, **spec)
             generate = cls.generators()[spec.pop("generator")]
