@@ -14,6 +14,7 @@ naming file and line, no traceback).
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 import time
 import warnings
@@ -115,13 +116,15 @@ def run(path: Path, out: Path | None, seed: int | None, duration_s: float | None
     ``include_path``: folders the trees' includes may also resolve into."""
     from .outputs import write_outputs
     from .runner import Mission
-    from .scenario import load_scenario
+    from .scenario import load_scenario, steps_problem
 
     if seed is not None and seed < 0:
         raise DelveError(f"--seed must be >= 0, got {seed}")
-    if duration_s is not None and not duration_s > 0:
-        raise DelveError(f"--duration-s must be > 0, got {duration_s}")
+    if duration_s is not None and (not math.isfinite(duration_s) or not duration_s > 0):
+        raise DelveError(f"--duration-s must be a finite number of seconds > 0, got {duration_s}")
     scenario = load_scenario(path, include_path=include_path)
+    if duration_s is not None and steps_problem(duration_s, scenario.dt_s):
+        raise DelveError(f"--duration-s {steps_problem(duration_s, scenario.dt_s)}")
     out = out or Path("delve-out") / scenario.name
     started = time.perf_counter()
     loaded = scenario.build_world(seed)

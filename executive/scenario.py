@@ -25,6 +25,22 @@ from .yamlio import YamlDict, YamlList, file_problem, load_yaml, plain
 
 SCHEMA_PATH = Path(__file__).parent / "schema" / "scenario.schema.json"
 DEFAULTS = {"seed": 0, "duration_s": 3600.0, "dt_s": 0.1, "coverage_period_s": 5.0}
+#: Most simulation steps a run may take (duration_s / dt_s). The shipped scenarios
+#: take at most 40 000 (cops_tunnel: 40 000 s at 1 s; demo: 2400 s at 0.1 s); a voxel
+#: world runs a few hundred to a few thousand steps a second, so 2 000 000 steps is
+#: hours of wall time: more is a typo (dt_s: 1e-6) that would never end.
+MAX_SIM_STEPS = 2_000_000
+
+
+def steps_problem(duration_s: float, dt_s: float) -> str | None:
+    """Why a run of ``duration_s`` in steps of ``dt_s`` cannot be run, or None."""
+    if not math.isfinite(duration_s) or not duration_s > 0:
+        return f"must be a finite number of seconds > 0, got {duration_s}"
+    steps = duration_s / dt_s
+    if steps > MAX_SIM_STEPS:
+        return (f"{duration_s:g} s in steps of dt_s {dt_s:g} s is {steps:.3g} steps, more than the limit of "
+                f"{MAX_SIM_STEPS:,}")
+    return None
 
 
 @lru_cache(maxsize=1)
@@ -187,6 +203,17 @@ def _nan(doc: Any, path: Path, where: tuple = ()) -> None:
         _nan(v, path, (*where, k))
 
 
+def _check_steps(doc: YamlDict, path: Path, duration_s: float, dt_s: float) -> None:
+    """A run over :data:`MAX_SIM_STEPS` steps is an error at ``dt_s`` (when the
+    duration would fit at the default step) or else at ``duration_s``."""
+    problem = steps_problem(duration_s, dt_s)
+    if problem is None:
+        return
+    at_dt = "dt_s" in doc and (duration_s / DEFAULTS["dt_s"] <= MAX_SIM_STEPS or "duration_s" not in doc)
+    key = "dt_s" if at_dt else "duration_s"
+    raise DelveError(f"{key}: {problem}", path, doc.key_line(key) or doc.line)
+
+
 def _world_backend(doc: YamlDict, path: Path) -> type[WorldBackend]:
     """The backend that claims the scenario's ``world:``; a DelveError if none does."""
     world = doc["world"]
@@ -292,6 +319,7 @@ def load_scenario(path: str | Path, include_path: Iterable[str | Path] = ()) -> 
     faults = load_faults(doc.get("faults"), FaultContext(path, {r.name: r for r in robots}, robot_types, backend,
                                                          base_tree is not None))
     values = {k: doc.get(k, v) for k, v in DEFAULTS.items()}
+    _check_steps(doc, path, float(values["duration_s"]), float(values["dt_s"]))
     backend.check(doc, path, base_tree is not None)
     team = _team(doc, path, tree_types)
     if team.strategy.NEEDS_BASE_TREE and base_tree is None:

@@ -37,6 +37,7 @@ import open3d as o3d
 
 from . import freespace
 from .geometry_io import Geometry, read_geometry
+from .limits import DEFAULT_VOXEL_SIZE_M, check_voxels, voxel_count
 from .meshio import closed_mesh_world, default_start, up_axis_rotation
 from .world import World, WorldSource
 from .worldgen_geometry import free_space_mesh
@@ -74,6 +75,7 @@ def from_file(path: str | Path, *, scale: float | None = None, up_axis: str | No
         if not math.isfinite(ceiling_m) or ceiling_m <= verts[:, 2].min():
             raise ValueError(f"ceiling_m {ceiling_m:g} is not above the model's bottom "
                              f"(z = {verts[:, 2].min():.2f} m)")
+    _check_size(verts, v, ceiling_m, path.name, scale is not None, factor)
     src = dict(file=path.name, format=geo.format, up_axis=up, up_axis_from=up_from, file_up_axis=geo.up_axis,
                scale=factor, scale_from=scale_from)
     name = name or path.stem
@@ -92,6 +94,22 @@ def from_file(path: str | Path, *, scale: float | None = None, up_axis: str | No
     else:
         world.start = default_start(world)
     return world
+
+
+def _check_size(verts: np.ndarray, v: float, ceiling_m: float | None, file: str, scaled: bool,
+                factor: float) -> None:
+    """ValueError before any grid is built when the model's box (up to the ceiling)
+    holds more voxels than a world may (sim/limits.py); it names ``scale`` when
+    the scenario gave one and the box is too large even at the default voxel size."""
+    if len(verts) == 0:
+        return
+    lo, hi = verts.min(axis=0), verts.max(axis=0).astype(float)
+    if ceiling_m is not None:
+        hi[2] = max(hi[2], ceiling_m)
+    extent = hi - lo
+    what = f"the model in {file!r} (a box of {extent[0]:.3g} x {extent[1]:.3g} x {extent[2]:.3g} m)"
+    check_voxels(voxel_count(extent, v), v, what, "scale" if scaled else None,
+                 voxel_count(extent, DEFAULT_VOXEL_SIZE_M) if scaled else None)
 
 
 def _positive(name: str, value: float) -> float:

@@ -20,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .limits import DEFAULT_VOXEL_SIZE_M, check_total_length, check_voxels
 from .meshio import from_mesh, write_scan_mesh
 from .world import World
 from .worldgen_cave import (CAVE_FLOOR_BAND_M, CavePlan, add_cave_branches, add_cave_upper,
@@ -77,6 +78,17 @@ def _check_range(name: str, rng_: tuple, voxel_size_m: float) -> tuple[float, fl
     return lo, hi
 
 
+def _check_size(total: float, width: tuple[float, float], height: tuple[float, float], v: float,
+                what: str) -> None:
+    """ValueError before planning when the world would be too long, or when its
+    passages alone (each at least the smallest width and height) would hold more
+    voxels than a world may (sim/limits.py); the box is checked again when built."""
+    check_total_length(total)
+    volume = total * width[0] * height[0]
+    check_voxels(volume / v ** 3, v, f"a {total:g} m {what} of passages at least {width[0]:g} x {height[0]:g} m",
+                 "total_length_m", volume / DEFAULT_VOXEL_SIZE_M ** 3)
+
+
 # ========================================================== generators
 def tunnel_network(seed: int, *, total_length_m: float = 400.0, spacing_m: float = 20.0,
                    levels: int = 1, shaft: bool = False, ramp: bool = True, loops: int = 2,
@@ -109,6 +121,7 @@ def tunnel_network(seed: int, *, total_length_m: float = 400.0, spacing_m: float
         raise ValueError(f"max_slope_deg must lie in (0, 60], got {max_slope_deg}")
     width = _check_range("width_m", width_m, v)
     height = _check_range("height_m", height_m, v)
+    _check_size(total, width, height, v, "network")
     if spacing < 2 * width[1] + CLEARANCE_M:
         raise ValueError(f"spacing_m={spacing} is too small for tunnels up to {width[1]} m wide: "
                          f"use at least {2 * width[1] + CLEARANCE_M} m")
@@ -190,6 +203,7 @@ def cave(seed: int, *, total_length_m: float = 250.0, width_m: tuple = (1.0, 15.
     v = _check_positive("voxel_size_m", voxel_size_m)
     width = _check_range("width_m", width_m, v)
     height = _check_range("height_m", height_m, v)
+    _check_size(total, width, height, v, "cave")
     rng = np.random.default_rng(seed)
     plan = CavePlan(rng, width, height, radius=CAVE_RADIUS_M + CAVE_RADIUS_PER_LENGTH * total)
     band = (-CAVE_FLOOR_BAND_M, CAVE_FLOOR_BAND_M)

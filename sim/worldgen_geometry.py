@@ -16,6 +16,7 @@ import open3d as o3d
 from scipy import ndimage
 from skimage import measure
 
+from .limits import check_voxels, voxel_count
 from .world import START_ABOVE_FLOOR_M, World
 
 #: Rock kept between passages that the plan does not join.
@@ -53,6 +54,9 @@ class VoxelCanvas:
         self.origin = np.floor((np.asarray(lo, float) - margin_m) / v) * v
         top = np.asarray(hi, float) + margin_m
         self.shape = tuple(int(n) for n in np.ceil((top - self.origin) / v - 1e-9))
+        extent = top - self.origin
+        check_voxels(voxel_count(extent, v), v, f"the world's box of {extent[0]:.0f} x {extent[1]:.0f} x "
+                     f"{extent[2]:.0f} m", "total_length_m")
         self.free = np.zeros(self.shape, dtype=bool)
 
     def window(self, lo, hi):

@@ -43,7 +43,16 @@ def test_shipped_scenarios_load(path):
 
 def test_run_rejects_bad_overrides(capsys):
     assert main(["run", str(SCENARIOS_DIR / "demo.yaml"), "--duration-s", "-1", "--quiet"]) == 2
-    assert "--duration-s must be > 0" in capsys.readouterr().err
+    assert "--duration-s must be a finite number of seconds > 0" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("value, expect", [("inf", "must be a finite number of seconds > 0, got inf"),
+                                           ("nan", "must be a finite number of seconds > 0, got nan"),
+                                           ("1e9", "steps, more than the limit of 2,000,000")])
+def test_run_refuses_an_endless_duration_before_building_the_world(value, expect, capsys):
+    assert main(["run", str(SCENARIOS_DIR / "demo.yaml"), "--duration-s", value, "--quiet"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "Traceback" not in err and expect in err, err
 
 
 def test_load_errors_are_delve_errors(tmp_path):
