@@ -27,6 +27,9 @@ ROCK_RGB = (0.93, 0.93, 0.93)
 #: The longer side of a picture (inches) and its limits on the shorter one.
 FIGURE_IN = 10.0
 MIN_SIDE_IN = 3.0
+#: A side view flatter than this (height / length) is stretched upwards to it, at most MAX_STRETCH times.
+FLAT_VIEW = 0.2
+MAX_STRETCH = 10
 
 
 def draw_preview(scenario: "Scenario", world: World, starts: list["StartPlacement"], out: Path) -> list[Path]:
@@ -44,8 +47,11 @@ def draw_preview(scenario: "Scenario", world: World, starts: list["StartPlacemen
         img[main.any(axis=flat)] = MAIN_RGB
         lo, hi = world.bounds_min, world.bounds_max
         extent = (lo[a], hi[a], lo[b], hi[b])
-        fig, ax = plt.subplots(figsize=_figsize(hi[a] - lo[a], hi[b] - lo[b]))
-        ax.imshow(np.transpose(img, (1, 0, 2)), origin="lower", extent=extent, interpolation="nearest")
+        w, h = hi[a] - lo[a], hi[b] - lo[b]
+        stretch = 1 if name == "top" or h >= FLAT_VIEW * w else min(int(round(FLAT_VIEW * w / h)), MAX_STRETCH)
+        fig, ax = plt.subplots(figsize=_figsize(w, h * stretch))
+        ax.imshow(np.transpose(img, (1, 0, 2)), origin="lower", extent=extent, interpolation="nearest",
+                  aspect=stretch)
         handles = [Patch(color=MAIN_RGB, label="free space (largest region)"),
                    Patch(color=ROCK_RGB, label="rock / outside")]
         if other.any():
@@ -56,13 +62,14 @@ def draw_preview(scenario: "Scenario", world: World, starts: list["StartPlacemen
         handles += _draw_starts(ax, world, starts, scenario, (a, b))
         ax.set_xlabel("x (m)")
         ax.set_ylabel("y (m)" if name == "top" else "z (m, up)")
-        view = "top view" if name == "top" else "side view (looking along +y)"
+        view = "top view" if name == "top" else "side view (looking along +y" + (
+            f", heights stretched ×{stretch})" if stretch > 1 else ")")
         ax.set_title(f"{scenario.name}: {view}\nfree {world.free_volume_m3:.0f} m³ in {n_regions} region(s), "
                      f"voxels of {world.voxel_size_m:g} m", fontsize=10)
         ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8, frameon=False)
         fig.tight_layout()
         path = out / f"{name}.png"
-        fig.savefig(path, dpi=110)
+        fig.savefig(path, dpi=110, bbox_inches="tight")
         plt.close(fig)
         paths.append(path)
     return paths
