@@ -123,7 +123,7 @@ def test_delve_run_prints_the_summary_first_and_quiet_keeps_only_warnings(tmp_pa
     bad = scenario(tmp_path, start=(2.0, 2.1, 1.0))
     assert main(["run", str(bad), "--out", str(tmp_path / "bad"), "--quiet"]) == 2
     _, err = capsys.readouterr()
-    assert "inside rock (nearest free floor" in err and not (tmp_path / "bad").exists()
+    assert "inside rock (nearest free floor" in err and not (tmp_path / "bad" / "report.json").exists()
 
 
 def test_a_graph_world_describes_itself_too():
