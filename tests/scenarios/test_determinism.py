@@ -1,5 +1,8 @@
-"""The same scenario and seed give the same report, byte for byte, wall clock aside."""
+"""The same scenario and seed give the same report, byte for byte, wall clock aside,
+on a quiet machine and on a busy one."""
 import json
+import multiprocessing
+import os
 
 from delve import SCENARIOS_DIR
 from delve.executive.outputs import strip_wall_clock
@@ -27,3 +30,41 @@ def test_the_cerberus_stack_is_deterministic_too(tmp_path):
     _, b = run_scenario(SCENARIOS_DIR / "cerberus_modes.yaml", tmp_path / "b")
     assert strip_wall_clock(a) == strip_wall_clock(b)
     assert (tmp_path / "a" / "log.jsonl").read_bytes() == (tmp_path / "b" / "log.jsonl").read_bytes()
+
+
+def _spin(stop) -> None:
+    while not stop.is_set():
+        pass
+
+
+def _without_wall_clock(log: str) -> list[dict]:
+    events = [json.loads(line) for line in log.splitlines()]
+    for e in events:
+        e.pop("solve_time_s", None)
+    return events
+
+
+def test_cops_plans_do_not_depend_on_the_machine_s_load(tmp_path):
+    """cops_under_load's solves are large enough that the former wall-clock limits bound
+    under load (its plans then differed from a quiet run's). Its limits are counted in
+    work now: run quiet, then with every core spinning, it gives the same report and
+    log (solve times aside), and no safety stop fired."""
+    _, quiet = run_scenario(DATA / "cops_under_load.yaml", tmp_path / "quiet")
+    ctx = multiprocessing.get_context("spawn")
+    stop = ctx.Event()
+    spinners = [ctx.Process(target=_spin, args=(stop,), daemon=True) for _ in range(os.cpu_count() or 2)]
+    for p in spinners:
+        p.start()
+    try:
+        _, busy = run_scenario(DATA / "cops_under_load.yaml", tmp_path / "busy")
+    finally:
+        stop.set()
+        for p in spinners:
+            p.join(timeout=5)
+            if p.is_alive():
+                p.terminate()
+    assert quiet["cops"]["safety_stops"] == 0 and quiet["cops"]["reproducible"]
+    assert quiet["cops"]["plans_valid"] == quiet["cops"]["cycles"] >= 4 and quiet["succeeded"]
+    assert strip_wall_clock(busy) == strip_wall_clock(quiet)
+    assert _without_wall_clock((tmp_path / "busy" / "log.jsonl").read_text()) == \
+        _without_wall_clock((tmp_path / "quiet" / "log.jsonl").read_text())
