@@ -22,6 +22,7 @@ from pathlib import Path
 
 from .. import SCENARIOS_DIR, TREES_DIR
 from .errors import DelveError
+from .outpaths import check_out_dir, check_out_file
 from .yamlio import YamlDict, load_yaml
 
 DEMO_SCENARIO = SCENARIOS_DIR / "demo.yaml"
@@ -126,6 +127,7 @@ def run(path: Path, out: Path | None, seed: int | None, duration_s: float | None
     if duration_s is not None and steps_problem(duration_s, scenario.dt_s):
         raise DelveError(f"--duration-s {steps_problem(duration_s, scenario.dt_s)}")
     out = out or Path("delve-out") / scenario.name
+    check_out_dir(out)
     started = time.perf_counter()
     loaded = scenario.build_world(seed)
     if not _print_world(scenario.world_backend.describe(scenario, loaded), quiet):
@@ -160,6 +162,8 @@ def world(path: Path, preview: Path | None, seed: int | None, include_path: tupl
     if seed is not None and seed < 0:
         raise DelveError(f"--seed must be >= 0, got {seed}")
     scenario = load_scenario(path, include_path=include_path)
+    if preview is not None:
+        check_out_dir(preview, "--preview")
     loaded = scenario.build_world(seed)
     ok = _print_world(scenario.world_backend.describe(scenario, loaded), quiet=False)
     if preview is not None:
@@ -227,8 +231,9 @@ def render(tree: Path, fmt: str, out: Path | None, include_path: tuple[Path, ...
     from .tree_loader import load_tree
 
     ctx = AgentContext(name="render", namespace="/render", clock=_Still(), log=lambda *a, **k: None)
-    root = load_tree(tree, ctx, include_path=include_path)
     out = out or tree.with_suffix(f".{fmt}")
+    check_out_file(out)
+    root = load_tree(tree, ctx, include_path=include_path)
     render_tree(root, fmt, out)
     print(f"wrote {out}")
     return 0
