@@ -141,7 +141,8 @@ def _held(mission: Any, name: str) -> dict[str, int]:
     out = {"messages": robot.radio.pending}
     base_map = getattr(mission.backend, "base_map", None)
     if base_map is not None:
-        out["map_voxels"] = int(((robot.onboard_map.occupancy != UNKNOWN) & (base_map.occupancy == UNKNOWN)).sum())
+        known = robot.onboard_map.occupancy != UNKNOWN
+        out["map_voxels"] = int((known & (base_map.occupancy == UNKNOWN)).sum())
     if isinstance(mission.team, Cops):
         skill = _cops_skill(mission.agents[name].root)
         st = skill.stored_state() if skill is not None else None
@@ -234,8 +235,10 @@ def fault_text(f: dict[str, Any]) -> str:
 def row(r: Run) -> str:
     verdict = "ok" if not r.violations else "FAIL " + ",".join(r.violations)
     state = "succeeded" if r.succeeded else ("timed out" if r.timed_out else "failed")
-    return (f"{r.index:>3} {r.scenario:<26} {' '.join(fault_text(f) for f in r.faults):<78} {r.sim_s:>6.0f} "
-            f"{r.wall_s:>6.1f} {state:<9} {','.join(r.lost) or '-':<8} {' '.join(r.held) or '-':<22} {verdict}")
+    faults = " ".join(fault_text(f) for f in r.faults)
+    lost, held = ",".join(r.lost) or "-", " ".join(r.held) or "-"
+    return (f"{r.index:>3} {r.scenario:<26} {faults:<78} {r.sim_s:>6.0f} {r.wall_s:>6.1f} {state:<9} "
+            f"{lost:<8} {held:<22} {verdict}")
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -252,8 +255,9 @@ def main(argv: list[str] | None = None) -> int:
         (k, n) for k in range(args.runs_per_scenario) for n in args.scenarios)]
     print(f"{len(jobs)} runs over {len(args.scenarios)} shipped scenarios, campaign seed {args.seed}, "
           f"outputs in {out}\n")
-    print(f"{'#':>3} {'scenario':<26} {'faults (kind@at_s+duration_s:target)':<78} {'sim s':>6} {'wall s':>6} "
-          f"{'outcome':<9} {'lost':<8} {'held':<22} invariants")
+    head = "faults (kind@at_s+duration_s:target)"
+    print(f"{'#':>3} {'scenario':<26} {head:<78} {'sim s':>6} {'wall s':>6} {'outcome':<9} {'lost':<8} "
+          f"{'held':<22} invariants")
     started = time.perf_counter()
     runs = []
     if args.jobs > 1:

@@ -41,7 +41,8 @@ MUCH_LEFT_FRACTION = 0.10
 #: Events in which behaviours say why they failed (besides every ``*_failed``).
 FAILURE_EVENTS = ("cops_no_plan", "cops_invalid_plan", "return_without_plan")
 #: Events that end a robot's exploration, well or not.
-EXPLORATION_ENDS = ("explore_failed", "exploration_complete", "planner_homing", "endurance_low", "homing_timer")
+EXPLORATION_ENDS = ("explore_failed", "exploration_complete", "planner_homing", "endurance_low",
+                    "homing_timer")
 
 
 @dataclass(frozen=True)
@@ -97,7 +98,8 @@ def _last_word(events: list[dict[str, Any]], agent: str) -> str | None:
 def exploration_failure(events: list[dict[str, Any]], agent: str) -> str | None:
     """The failure an agent's exploration ended with, when its last exploration end
     (:data:`EXPLORATION_ENDS`) was one; else None."""
-    last = next((e for e in reversed(events) if e.get("agent") == agent and e["event"] in EXPLORATION_ENDS), None)
+    ends = (e for e in reversed(events) if e.get("agent") == agent and e["event"] in EXPLORATION_ENDS)
+    last = next(ends, None)
     return failure_event([last], agent) if last is not None and last["event"] == "explore_failed" else None
 
 
@@ -107,7 +109,7 @@ def agent_reason(mission: "Mission", agent: "Agent", timed_out: bool) -> str:
     if status == Status.FAILURE:
         node = failing_node(agent.root)
         why = failure_event(mission.state.events, agent.name)
-        feedback = node.feedback_message if node.feedback_message and node.feedback_message not in (why or "") else ""
+        feedback = node.feedback_message if node.feedback_message not in (why or "") else ""
         return (f"{agent.name}: FAILURE at {node.name!r}" + (f" ({feedback})" if feedback else "")
                 + (f": {why}" if why else ""))
     when = (f"when the run stopped at its duration ({mission.duration_s:g} s)" if timed_out
@@ -126,7 +128,8 @@ def mission_outcome(mission: "Mission") -> Outcome:
         if not reasons:
             reasons.append(f"the team strategy ({type(team).__name__}) judged the mission failed")
     if mission.robots and all(name in mission.lost for name in mission.robots):
-        reasons.append("every robot was lost: " + ", ".join(f"{n} ({why})" for n, why in mission.lost.items()))
+        lost = ", ".join(f"{n} ({why})" for n, why in mission.lost.items())
+        reasons.append(f"every robot was lost: {lost}")
     for name, robot in mission.robots.items():
         if name not in mission.lost and robot.distance_m < MIN_DISTANCE_M:
             word = _last_word(mission.state.events, name)
@@ -136,12 +139,14 @@ def mission_outcome(mission: "Mission") -> Outcome:
     if samples:
         start, end = samples[0].team, samples[-1].team
         if end - start < MIN_PROGRESS_FRACTION and 1.0 - start >= MUCH_LEFT_FRACTION:
-            reasons.append(f"the team explored {max(end - start, 0.0):.1%} of the world beyond what it saw at its "
-                           f"start (at least {MIN_PROGRESS_FRACTION:.0%} expected, {1.0 - start:.0%} was unexplored)")
+            gain = max(end - start, 0.0)
+            reasons.append(f"the team explored {gain:.1%} of the world beyond what it saw at "
+                           f"its start (at least {MIN_PROGRESS_FRACTION:.0%} expected, {1.0 - start:.0%} was "
+                           f"unexplored)")
     notes = []
     for agent in mission.robot_agents:
         failure = exploration_failure(mission.state.events, agent.name)
         if agent.root.status == Status.SUCCESS and failure:
             notes.append(f"{agent.name}: SUCCESS, but its exploration ended with {failure}")
-    return Outcome(succeeded=not reasons, timed_out=timed_out, reasons=tuple(reasons), lost=dict(mission.lost),
-                   notes=tuple(notes))
+    return Outcome(succeeded=not reasons, timed_out=timed_out, reasons=tuple(reasons),
+                   lost=dict(mission.lost), notes=tuple(notes))

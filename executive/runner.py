@@ -205,7 +205,8 @@ class Mission:
         lost = len(radio.inbox) + len(radio.outbox)
         radio.inbox.clear()
         radio.outbox.clear()
-        tree = self.scenario.base_tree if name == BASE else next(r.tree for r in self.scenario.robots if r.name == name)
+        specs = {r.name: r.tree for r in self.scenario.robots}
+        tree = self.scenario.base_tree if name == BASE else specs[name]
         root = load_tree(tree, ctx, include_path=self.scenario.include_path)
         self.agents[name] = Agent(name, root, old.period_s, ctx, on_change=self._status_changed,
                                   next_tick_s=resume_s)

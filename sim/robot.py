@@ -89,7 +89,8 @@ class SimRobot(RobotBody):
 
         self._payload: PanTiltZoomCamera | None = None
 
-        self._all_sensors = [(spec, spec.beam_directions(0.0)) for spec in (platform.lidar, platform.terrain) if spec]
+        self._all_sensors = [(spec, spec.beam_directions(0.0))
+                             for spec in (platform.lidar, platform.terrain) if spec]
         self._sensors = list(self._all_sensors)
 
     # ---- the robot interface (the rest in RobotBody) ----------------------------

@@ -129,4 +129,5 @@ class Fault:
         return {}
 
     def __repr__(self) -> str:
-        return f"{type(self).__name__}(at_s={self.at_s}, target={self.target}, duration_s={self.duration_s}, {self.p})"
+        return (f"{type(self).__name__}(at_s={self.at_s}, target={self.target}, "
+                f"duration_s={self.duration_s}, {self.p})")

@@ -25,53 +25,58 @@ def _world_name(ctx: FaultContext) -> str:
     return next((n for n, b in WORLD_BACKENDS.items() if b is ctx.backend), ctx.backend.__name__)
 
 
+def _error(message: str, ctx: FaultContext, item: YamlDict, key: str | None = None) -> DelveError:
+    """A one-line error at ``key`` of ``item`` (at the entry when ``key`` is None)."""
+    return DelveError(message, ctx.path, item.key_line(key) if key is not None else item.line)
+
+
 def _number(item: YamlDict, key: str, ctx: FaultContext, what: str, positive: bool) -> float:
     value = item[key]
-    ok = not isinstance(value, bool) and isinstance(value, (int, float)) and (value > 0 if positive else value >= 0)
-    if not ok:
-        raise DelveError(f"fault: {key} must be {what}, got {value!r}", ctx.path, item.key_line(key))
+    number = not isinstance(value, bool) and isinstance(value, (int, float))
+    if not (number and (value > 0 if positive else value >= 0)):
+        raise _error(f"fault: {key} must be {what}, got {value!r}", ctx, item, key)
     return float(value)
 
 
 def _target(cls: type[Fault], item: YamlDict, ctx: FaultContext) -> Target:
     """The entry's one target, checked against what the kind may hit."""
+    kind = cls.KIND
     given = [k for k in (ROBOT, LINK, BASE_STATION) if k in item]
     if len(given) > 1:
-        raise DelveError(f"fault {cls.KIND!r}: give one target, {given[0]!r} or {given[1]!r}, not both", ctx.path,
-                         item.key_line(given[1]))
+        raise _error(f"fault {kind!r}: give one target, {given[0]!r} or {given[1]!r}, not both", ctx, item,
+                     given[1])
     if not given:
         if cls.TARGETS == (BASE_STATION,):
             return Target(BASE_STATION)
         wanted = " or ".join(repr(t) for t in cls.TARGETS)
-        raise DelveError(f"fault {cls.KIND!r}: {wanted} is missing (whom it hits)", ctx.path, item.line)
+        raise _error(f"fault {kind!r}: {wanted} is missing (whom it hits)", ctx, item)
     key = given[0]
     if key not in cls.TARGETS:
         can = ", ".join(TARGET_WORDS[t] for t in cls.TARGETS)
-        raise DelveError(f"fault {cls.KIND!r} hits {can}, not {TARGET_WORDS[key]}", ctx.path, item.key_line(key))
+        raise _error(f"fault {kind!r} hits {can}, not {TARGET_WORDS[key]}", ctx, item, key)
     value = item[key]
     if key == ROBOT:
         if value not in ctx.robots:
-            raise DelveError(f"fault for unknown robot {value!r}{did_you_mean(str(value), ctx.robots)}", ctx.path,
-                             item.key_line(key))
+            hint = did_you_mean(str(value), ctx.robots)
+            raise _error(f"fault for unknown robot {value!r}{hint}", ctx, item, key)
         return Target(ROBOT, (value,))
     if key == BASE_STATION:
         if value is not True:
-            raise DelveError(f"fault {cls.KIND!r}: write 'base_station: true', or name a robot or a link", ctx.path,
-                             item.key_line(key))
+            raise _error(f"fault {kind!r}: write 'base_station: true', or name a robot or a link", ctx, item,
+                         key)
         return Target(BASE_STATION)
     from ..worlds import BASE
 
     agents = [*ctx.robots, BASE]
     if not isinstance(value, list) or len(value) != 2 or not all(isinstance(v, str) for v in value):
-        raise DelveError(f"fault {cls.KIND!r}: link must name two agents, e.g. [{agents[0]}, {BASE}]", ctx.path,
-                         item.key_line(key))
+        raise _error(f"fault {kind!r}: link must name two agents, e.g. [{agents[0]}, {BASE}]", ctx, item, key)
     for name in value:
         if name not in agents:
-            raise DelveError(f"fault {cls.KIND!r}: link names unknown agent {name!r}{did_you_mean(name, agents)} "
-                             f"(robots, or '{BASE}' for the base station)", ctx.path, item.key_line(key))
+            raise _error(f"fault {kind!r}: link names unknown agent {name!r}{did_you_mean(name, agents)} "
+                         f"(robots, or '{BASE}' for the base station)", ctx, item, key)
     if value[0] == value[1]:
-        raise DelveError(f"fault {cls.KIND!r}: a link joins two different agents, not {value[0]!r} twice", ctx.path,
-                         item.key_line(key))
+        raise _error(f"fault {kind!r}: a link joins two different agents, not {value[0]!r} twice", ctx, item,
+                     key)
     return Target(LINK, tuple(sorted(value)))
 
 
@@ -85,14 +90,14 @@ def _params(cls: type[Fault], item: YamlDict, ctx: FaultContext) -> dict[str, An
             allowed = [*cls.PARAMS, "duration_s"] if cls.DURATION != NEVER else list(cls.PARAMS)
             has = f" (it has {', '.join(map(repr, cls.PARAMS))})" if cls.PARAMS else " (it has no parameters)"
             hint = did_you_mean(str(key), allowed) or has
-            raise DelveError(f"fault {cls.KIND!r}: unknown parameter {key!r}{hint}", ctx.path, item.key_line(key))
+            raise _error(f"fault {cls.KIND!r}: unknown parameter {key!r}{hint}", ctx, item, key)
         problem = spec.problem(value)
         if problem:
-            raise DelveError(f"fault {cls.KIND!r}: {key} {problem}", ctx.path, item.key_line(key))
+            raise _error(f"fault {cls.KIND!r}: {key} {problem}", ctx, item, key)
         params[key] = float(value) if spec.type is float and value is not None else plain(value)
     for key, spec in cls.PARAMS.items():
         if spec.required and key not in params:
-            raise DelveError(f"fault {cls.KIND!r} needs {key!r} ({spec.doc})", ctx.path, item.line)
+            raise _error(f"fault {cls.KIND!r} needs {key!r} ({spec.doc})", ctx, item)
     return params
 
 
@@ -102,24 +107,24 @@ def load_fault(item: Any, line: int | None, ctx: FaultContext) -> Fault:
         raise DelveError("faults: each fault must be a mapping (at_s, kind, robot, ...)", ctx.path, line)
     for key in ("at_s", "kind"):
         if key not in item:
-            raise DelveError(f"fault: {key!r} is missing", ctx.path, item.line)
+            raise _error(f"fault: {key!r} is missing", ctx, item)
     kind = item["kind"]
     cls = FAULT_KINDS.get(kind) if isinstance(kind, str) else None
     if cls is None:
-        raise DelveError(f"unknown fault kind {kind!r}{did_you_mean(str(kind), FAULT_KINDS)} "
-                         f"(one of {', '.join(FAULT_KINDS)})", ctx.path, item.key_line("kind"))
+        raise _error(f"unknown fault kind {kind!r}{did_you_mean(str(kind), FAULT_KINDS)} "
+                     f"(one of {', '.join(FAULT_KINDS)})", ctx, item, "kind")
     world = _world_name(ctx)
     if (cls.WORLDS is not None and world not in cls.WORLDS) or kind in ctx.backend.UNSUPPORTED_FAULTS:
-        raise DelveError(f"a {kind!r} fault does not apply to this world ({world})", ctx.path, item.key_line("kind"))
+        raise _error(f"a {kind!r} fault does not apply to this world ({world})", ctx, item, "kind")
     at_s = _number(item, "at_s", ctx, "a time >= 0", positive=False)
     target = _target(cls, item, ctx)
     duration = None
     if "duration_s" in item:
         if cls.DURATION == NEVER:
-            raise DelveError(f"a {kind!r} fault does not end: remove duration_s", ctx.path, item.key_line("duration_s"))
+            raise _error(f"a {kind!r} fault does not end: remove duration_s", ctx, item, "duration_s")
         duration = _number(item, "duration_s", ctx, "a time > 0", positive=True)
     elif cls.DURATION == REQUIRED:
-        raise DelveError(f"a {kind!r} fault needs duration_s", ctx.path, item.line)
+        raise _error(f"a {kind!r} fault needs duration_s", ctx, item)
     params = _params(cls, item, ctx)
     cls.check(item, target, ctx)
     return cls(at_s, target, duration, line=item.line, **params)

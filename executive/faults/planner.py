@@ -2,8 +2,9 @@
 
 The seam is the agent's planner service (``ctx.services["gbplanner"]``, the one
 GBPlanner2 that ``ExploreGBPlanner2``, ``Home``, ``GoTo`` and ``Relocate`` of a robot
-share): the fault wraps that planner's ``plan`` (a wrapper that passes the call through once
-the fault has ended, so that overlapping faults nest). Skills see a planner that raises (``ExploreGBPlanner2`` logs ``explore_failed`` with the error and fails)
+share): the fault wraps that planner's ``plan``, and the wrapper passes every call
+through once the fault has ended (so overlapping faults nest). Skills see a planner
+that raises (``ExploreGBPlanner2`` logs ``explore_failed`` with the error and fails)
 or a plan that arrives late (the robot stands while the planner "thinks"), and never
 learn that a simulator exists. The service is made by the robot's first plan; a
 fault that starts before it takes hold as soon as it exists.

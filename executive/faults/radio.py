@@ -80,7 +80,8 @@ class BreadcrumbDies(Fault):
         if carried < number:
             where = "number" if "number" in item else "robot"
             raise DelveError(f"fault {cls.KIND!r}: robot {target.names[0]!r} carries {carried} breadcrumbs, "
-                             f"it never drops number {number} (set its 'breadcrumbs')", ctx.path, item.key_line(where))
+                             f"it never drops number {number} (set its 'breadcrumbs')", ctx.path,
+                             item.key_line(where))
 
     @property
     def breadcrumb(self) -> str:

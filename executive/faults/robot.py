@@ -44,7 +44,7 @@ class BatteryDrop(Fault):
     says "endurance exhausted"."""
 
     KIND = "battery_drop"
-    PARAMS = {"drop_fraction": Param(float, 0.5, "share of the remaining endurance lost (1: the battery is flat)",
+    PARAMS = {"drop_fraction": Param(float, 0.5, "share of the remaining endurance lost (1: flat)",
                                      exclusive_minimum=0.0, maximum=1.0)}
 
     def start(self, mission: "Mission") -> dict[str, Any]:

@@ -19,8 +19,8 @@ class MapArtifact(Fault):
     within ``radius_m`` around it, as odometry drift leaves in a real map."""
 
     KIND = "map_artifact"
-    PARAMS = {"radius_m": Param(float, 1.5, "radius of the phantom rock around the robot", exclusive_minimum=0.0,
-                                maximum=100.0)}
+    PARAMS = {"radius_m": Param(float, 1.5, "radius of the phantom rock around the robot",
+                                exclusive_minimum=0.0, maximum=100.0)}
     WORLDS = ("voxel",)
 
     def start(self, mission: "Mission") -> dict[str, Any]:
@@ -36,8 +36,8 @@ class LidarDegraded(Fault):
     KIND = "lidar_degraded"
     DURATION = OPTIONAL
     PARAMS = {
-        "range_m": Param(float, None, "the sensors' range while degraded (null: unchanged)", exclusive_minimum=0.0,
-                         maximum=1e3, nullable=True),
+        "range_m": Param(float, None, "the sensors' range while degraded (null: unchanged)",
+                         exclusive_minimum=0.0, maximum=1e3, nullable=True),
         "ray_fraction": Param(float, 1.0, "share of the beams that still return (0: a dropout)", minimum=0.0,
                               maximum=1.0),
     }
@@ -89,7 +89,8 @@ class LocalisationDrift(Fault):
     KIND = "localisation_drift"
     DURATION = OPTIONAL
     PARAMS = {
-        "rate_mps": Param(float, 0.05, "drift per second of motion (m/s)", exclusive_minimum=0.0, maximum=10.0),
+        "rate_mps": Param(float, 0.05, "drift per second of motion (m/s)", exclusive_minimum=0.0,
+                          maximum=10.0),
         "heading_deg": Param(float, 90.0, "direction of the drift in the horizontal plane (0: +x, 90: +y)",
                              minimum=-360.0, maximum=360.0),
     }
@@ -101,8 +102,8 @@ class LocalisationDrift(Fault):
         return self.p["rate_mps"] * np.array([math.cos(a), math.sin(a), 0.0])
 
     def _apply(self, mission: "Mission") -> None:
-        mission.robots[self.robot].drift(sum((f.velocity() for f in mission.faults.holding(LocalisationDrift,
-                                                                                            self.robot)), np.zeros(3)))
+        held = mission.faults.holding(LocalisationDrift, self.robot)
+        mission.robots[self.robot].drift(sum((f.velocity() for f in held), np.zeros(3)))
 
     def start(self, mission: "Mission") -> dict[str, Any]:
         self._apply(mission)

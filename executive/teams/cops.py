@@ -99,7 +99,8 @@ class Cops(TeamStrategy):
                    "locations_undelivered": len(held - self.explored_at_base())}
         if mission.backend.map_undelivered(name) is not None:
             own = {k for k in (st.knowledge.map_chunks if st is not None else {}) if k.startswith(f"{name}/")}
-            figures["map_chunks_undelivered"] = len(own - set(base.knowledge.map_chunks if base is not None else ()))
+            at_base = set(base.knowledge.map_chunks) if base is not None else set()
+            figures["map_chunks_undelivered"] = len(own - at_base)
         return figures
 
     def explored_at_base(self) -> set[str]:

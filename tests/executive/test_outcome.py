@@ -17,7 +17,8 @@ from delve.skills.cops import CopsState
 def tree(*statuses: Status, selector: bool = False) -> py_trees.behaviour.Behaviour:
     """A composite whose children ended with ``statuses``; the root ended FAILURE."""
     kind = py_trees.composites.Selector if selector else py_trees.composites.Sequence
-    root = kind("Root", memory=True, children=[py_trees.behaviours.Dummy(f"c{i}") for i in range(len(statuses))])
+    children = [py_trees.behaviours.Dummy(f"c{i}") for i in range(len(statuses))]
+    root = kind("Root", memory=True, children=children)
     for child, status in zip(root.children, statuses):
         child.status = status
     root.status = Status.FAILURE
@@ -61,21 +62,22 @@ def test_a_mission_whose_robots_succeeded_and_explored_succeeded():
 
 
 def test_every_failure_is_explained():
-    events = [{"event": "explore_failed", "agent": "a", "reason": "invalid_start", "detail": "start position is "
-               "invalid"}]
+    events = [{"event": "explore_failed", "agent": "a", "reason": "invalid_start",
+               "detail": "start position is invalid"}]
     out = mission_outcome(mission({"a": Status.FAILURE, "b": Status.INVALID}, {"a": 30.0, "b": 40.0},
                                   events=events, timed_out=True))
     assert not out.succeeded and out.timed_out
-    assert out.reasons == ("a: FAILURE at 'Explore': explore_failed: invalid_start, start position is invalid",
-                           "b: had not finished when the run stopped at its duration (600 s)")
+    assert out.reasons == (
+        "a: FAILURE at 'Explore': explore_failed: invalid_start, start position is invalid",
+        "b: had not finished when the run stopped at its duration (600 s)")
 
 
 def test_a_robot_that_never_left_its_start_is_no_success_even_when_its_tree_succeeded():
     events = [{"event": "exploration_complete", "agent": "a", "blacklisted_voxels": 400}]
     out = mission_outcome(mission({"a": Status.SUCCESS}, {"a": 0.4 * MIN_DISTANCE_M}, events=events))
     assert not out.succeeded
-    assert out.reasons[0] == ("a: never left its start (0.4 m travelled); exploration complete with 400 frontier "
-                              "voxels blacklisted")
+    assert out.reasons[0] == ("a: never left its start (0.4 m travelled); exploration complete with 400 "
+                              "frontier voxels blacklisted")
 
 
 def test_a_team_that_explored_nothing_when_much_was_left_is_no_success():
@@ -94,10 +96,12 @@ def test_lost_robots_are_listed_and_do_not_fail_the_team_unless_none_is_left():
 
 
 def test_a_success_after_a_failed_exploration_has_a_note():
-    events = [{"event": "explore_failed", "agent": "a", "reason": "error", "detail": "InjectedPlannerError: x"}]
+    events = [{"event": "explore_failed", "agent": "a", "reason": "error",
+               "detail": "InjectedPlannerError: x"}]
     out = mission_outcome(mission({"a": Status.SUCCESS}, {"a": 50.0}, events=events))
-    assert out.succeeded and out.notes == ("a: SUCCESS, but its exploration ended with explore_failed: error, "
-                                           "InjectedPlannerError: x",)
+    assert out.succeeded
+    assert out.notes == ("a: SUCCESS, but its exploration ended with explore_failed: error, "
+                         "InjectedPlannerError: x",)
     later = events + [{"event": "exploration_complete", "agent": "a"}]
     assert mission_outcome(mission({"a": Status.SUCCESS}, {"a": 50.0}, events=later)).notes == ()
 

@@ -88,7 +88,8 @@ def test_a_degraded_lidar_maps_only_near_the_robot_and_a_dropout_maps_nothing(tm
     centres = robot.onboard_map.origin + (voxels + 0.5) * robot.onboard_map.voxel_size_m
     far = cKDTree(trail).query(centres)[0]
     assert len(voxels) and far.max() <= 3.0 + 1.5, "a 3 m sensor maps nothing farther from the robot's way"
-    later = robot.onboard_map.origin + (np.argwhere(seen[85][0] != UNKNOWN) + 0.5) * robot.onboard_map.voxel_size_m
+    voxel = robot.onboard_map.voxel_size_m
+    later = robot.onboard_map.origin + (np.argwhere(seen[85][0] != UNKNOWN) + 0.5) * voxel
     assert cKDTree(seen[85][1]).query(later)[0].max() > 6.0, "the full range is back at 60 s"
     dropout = [s.robots["anymal"] for s in samples_in(mission, 90, 120)]
     assert len(dropout) == 6 and len(set(dropout)) == 1, "blind: the map does not grow"
@@ -160,7 +161,7 @@ def test_a_drifting_pose_smears_the_map_until_the_robot_relocalises(tmp_path):
 """, duration_s=80)))
     mission.run(progress=watch, progress_period_s=10.0)
     assert phantom[20][1] == 0.0 and 0.5 < phantom[50][1] < 4.0
-    assert phantom[60][0] > phantom[20][0] + 1000, "walls integrated at the drifted pose: rock where it is free"
+    assert phantom[60][0] > phantom[20][0] + 1000, "walls mapped at the drifted pose: rock where it is free"
     ended = events(mission, "fault_end")[0]
     assert ended["drift_m"] > phantom[50][1] and phantom[70][1] == 0.0
     robot = mission.robots["anymal"]

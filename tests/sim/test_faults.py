@@ -23,8 +23,9 @@ def tunnel():
     """One straight tunnel along x from 0 to 60 m, 4 m wide and 3 m high."""
     canvas = VoxelCanvas(np.array([-3.0, -3.0, 0.0]), np.array([63.0, 3.0, 3.0]), V)
     carve_tunnel(canvas, [0.0, 0.0, 0.0], [60.0, 0.0, 0.0], 4.0, 3.0)
-    return World(name="fault-test", voxel_size_m=V, origin=canvas.origin, free=canvas.free,
-                 mesh=free_space_mesh(canvas.free, canvas.origin, V), centreline=nx.Graph(), start=[1.0, 0.0, 0.01])
+    mesh = free_space_mesh(canvas.free, canvas.origin, V)
+    return World(name="fault-test", voxel_size_m=V, origin=canvas.origin, free=canvas.free, mesh=mesh,
+                 centreline=nx.Graph(), start=[1.0, 0.0, 0.01])
 
 
 def make(world, platform=AERIAL, endurance_s=None, x=5.0):
