@@ -34,7 +34,7 @@ from typing import Any
 from py_trees.behaviour import Behaviour
 
 from .. import TREES_DIR
-from ..skills.base import AgentContext, short_repr
+from ..skills.base import KEY_PATTERN, KEY_RULE, AgentContext, Skill, short_repr
 from .errors import DelveError, clip_message, did_you_mean, display_path
 from .registry import Build, NodeType, Registry, Site, coerce_param, default_registry
 from .yamlio import YamlDict, YamlList, file_problem, line_of, line_of_key_named, load_yaml
@@ -104,6 +104,15 @@ def check_context() -> AgentContext:
     return AgentContext(name="check", namespace="/__check__", clock=_ZeroClock(), log=lambda *args, **fields: None)
 
 
+class _RemapFrame:
+    """An include being built: its remap, and the keys its subtree's nodes name (in
+    the naming of the including file's include, before the remap applies)."""
+
+    def __init__(self, remap: dict[str, str]):
+        self.remap = remap
+        self.named: set[str] = set()
+
+
 class _TreeBuilder:
     def __init__(self, ctx: AgentContext, registry: Registry, root_file: str | None,
                  include_path: Iterable[str | os.PathLike[str]] = ()):
@@ -112,6 +121,7 @@ class _TreeBuilder:
         self.root_dir = os.path.dirname(os.path.realpath(root_file)) if root_file else os.getcwd()
         self.roots = allowed_include_roots(root_file, include_path)
         self.depth = 0
+        self.frames: list[_RemapFrame] = []
 
     # ---------------------------------------------------------------- files
 
@@ -187,14 +197,18 @@ class _TreeBuilder:
         if not isinstance(inner, Mapping):
             site.fail(f"'remap' must be a mapping of subtree key -> key, not {_describe(inner)}", "remap")
         for key, value in inner.items():
+            line_hint = inner.key_line(key) if isinstance(inner, YamlDict) else None
             if not isinstance(key, str) or not key or not isinstance(value, str) or not value:
-                line_hint = inner.key_line(key) if isinstance(inner, YamlDict) else None
                 raise DelveError(
                     f"remap entries must map a key name to a key name, not {short_repr(key)}: {short_repr(value)}",
                     file,
                     line_hint or site.line_of("remap"),
                     name,
                 )
+            for what, text in (("key", key), ("value", value)):
+                if not KEY_PATTERN.fullmatch(text):
+                    raise DelveError(f"remap {what} {short_repr(text)} is not a blackboard key ({KEY_RULE})", file,
+                                     line_hint or site.line_of("remap"), name)
         base = os.path.dirname(file) if file else ""
         path = os.path.normpath(os.path.join(base, target))
         real = os.path.realpath(path)
@@ -210,10 +224,38 @@ class _TreeBuilder:
         if problem:
             site.fail(f"included file {problem}: {short_repr(target)} (relative to {display_path(base or '.')})",
                       "include")
-        root = self.file(path, compose_remap(inner, remap), (*chain, real), site)
+        frame = _RemapFrame(dict(inner))
+        self.frames.append(frame)
+        try:
+            root = self.file(path, compose_remap(inner, remap), (*chain, real), site)
+        finally:
+            self.frames.pop()
+        for key in inner:
+            if key not in frame.named:
+                line_hint = inner.key_line(key) if isinstance(inner, YamlDict) else None
+                raise DelveError(f"remap {short_repr(key)}: no node of {short_repr(target)} names that key"
+                                 f"{did_you_mean(key, sorted(frame.named))}", file,
+                                 line_hint or site.line_of("remap"), name)
         if name is not None:
             root.name = name
         return root
+
+    def note_keys(self, node_type: NodeType, params: Mapping[str, Any], built: Behaviour) -> None:
+        """Record the blackboard keys a node names (in its own file) with every
+        include it lies in, each in the naming of that include's file."""
+        if not self.frames:
+            return
+        keys = {value for pname, value in params.items()
+                if node_type.params[pname].key and isinstance(value, str)}
+        if isinstance(built, Skill):
+            ports = {**built.INPUT_PORTS, **built.OUTPUT_PORTS}
+            keys |= {k for k in (built.port_key(p) for p in ports) if k}
+        for frame in reversed(self.frames):
+            named = keys | {k.split(".", 1)[0] for k in keys}
+            frame.named |= named
+            keys = {frame.remap.get(k) or (frame.remap[k.split(".", 1)[0]] + "." + k.split(".", 1)[1]
+                                           if "." in k and k.split(".", 1)[0] in frame.remap else k)
+                    for k in keys}
 
     def typed(self, data: Mapping[str, Any], file: str | None, line: int | None, remap: dict[str, str], chain: tuple[str, ...]) -> Behaviour:
         site = Site(file, data, None, line)
@@ -254,7 +296,9 @@ class _TreeBuilder:
             site=site,
         )
         try:
-            return node_type.build(build)
+            built = node_type.build(build)
+            self.note_keys(node_type, params, built)
+            return built
         except DelveError:
             raise
         except (ValueError, TypeError) as err:  # the builder refused the checked parameters

@@ -15,7 +15,7 @@ from typing import Any
 
 from py_trees.ports import PortInformation
 
-from ..skills.base import Param
+from ..skills.base import KEY_PATTERN, Param
 from .node_types import NodeType, type_names
 from .registry import Registry, default_registry
 
@@ -53,6 +53,12 @@ def param_schema(spec: Param) -> dict[str, Any]:
         out["exclusiveMinimum"] = spec.exclusive_minimum
     if spec.maximum is not None:
         out["maximum"] = spec.maximum
+    if spec.length is not None:
+        out["minItems"] = out["maxItems"] = spec.length
+    if spec.items is not None and spec.items in _JSON_TYPES:
+        out["items"] = {"type": _JSON_TYPES[spec.items]}
+    if spec.key and spec.type is str:
+        out["pattern"] = f"^{KEY_PATTERN.pattern}$"
     if spec.choices is not None:
         out["enum"] = [*spec.choices, *([None] if spec.nullable else [])]
     if not spec.required and _json_serialisable(spec.default):

@@ -88,6 +88,12 @@ def _fits_float(value: int) -> bool:
     return True
 
 
+#: A blackboard key as a tree names it: names of letters, digits and _ joined by '/'
+#: (a leading '/' makes it shared by all agents) or '.' (an attribute of a key).
+KEY_PATTERN = re.compile(r"/?[A-Za-z0-9_]+(?:[/.][A-Za-z0-9_]+)*")
+KEY_RULE = "names of letters, digits and _ joined by '/', or '.' for an attribute"
+
+
 # delve keeps its own Param for a node's YAML parameters: py_trees' PortInformation
 # (type, required, description, default) has no bounds, choices, null-ability or key
 # marking, and the tree loader needs those to check a YAML node (with its file and
@@ -112,6 +118,10 @@ class Param:
     choices: tuple[Any, ...] | None = None
     key: bool = False
     nullable: bool = False
+    #: For a list: how many items it must have, and their type (``float``: finite
+    #: numbers; ``str``, ...), or None for any.
+    length: int | None = None
+    items: type | None = None
 
     @property
     def required(self) -> bool:
@@ -129,13 +139,17 @@ class Param:
                 return f"must be a number within +-1.8e308, not {shown}"
             if math.isnan(value):
                 return "must be a number, not NaN"
-            if math.isinf(value) and self.maximum is not None:
-                return "must be finite"
+            if math.isinf(value):  # no duration, distance or rate of a tree is endless
+                return f"must be a finite number, not {value}"
         elif self.type is int:
             if isinstance(value, bool) or not isinstance(value, int):
                 return f"must be an integer, not {shown}{yaml_number_hint(value, integer=True)}"
         elif not isinstance(value, self.type) or (self.type is not bool and isinstance(value, bool)):
             return f"must be of type {self.type.__name__}, not {shown}"
+        if self.key and isinstance(value, str) and not KEY_PATTERN.fullmatch(value):
+            return f"must be a blackboard key ({KEY_RULE}), not {short_repr(value)}"
+        if self.type is list:
+            return self._list_problem(value)
         if self.minimum is not None and value < self.minimum:
             return f"must be >= {self.minimum}, got {short_repr(value)}"
         if self.exclusive_minimum is not None and value <= self.exclusive_minimum:
@@ -144,6 +158,26 @@ class Param:
             return f"must be <= {self.maximum}, got {short_repr(value)}"
         if self.choices is not None and value not in self.choices:
             return f"must be one of {', '.join(map(repr, self.choices))}, got {short_repr(value)}"
+        return None
+
+
+    def _list_problem(self, value: list) -> str | None:
+        if self.length is not None and len(value) != self.length:
+            what = f"{self.length} numbers" if self.items is float else f"{self.length} items"
+            return f"must be a list of {what}, not {len(value)}: {short_repr(value)}"
+        if self.items is float:
+            for i, item in enumerate(value):
+                if isinstance(item, bool) or not isinstance(item, (int, float)):
+                    return (f"item {i} must be a number, not {type(item).__name__} {short_repr(item)}"
+                            f"{yaml_number_hint(item)}")
+                if isinstance(item, int) and not _fits_float(item):
+                    return f"item {i} must be a number within +-1.8e308, not {short_repr(item)}"
+                if not math.isfinite(item):
+                    return f"item {i} must be a finite number, not {item}"
+        elif self.items is not None:
+            for i, item in enumerate(value):
+                if not isinstance(item, self.items) or isinstance(item, bool) and self.items is not bool:
+                    return f"item {i} must be of type {self.items.__name__}, not {short_repr(item)}"
         return None
 
 

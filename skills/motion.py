@@ -53,7 +53,8 @@ class GoTo(PathMotion):
     """
 
     PARAMS = {
-        "goal": Param(list, None, "waypoint [x, y, z] (m); null: read goal_key", nullable=True),
+        "goal": Param(list, None, "waypoint [x, y, z] (m); null: read goal_key", nullable=True, length=3,
+                      items=float),
         "goal_key": Param(str, "goal", "blackboard key holding the waypoint [x, y, z]", key=True),
         "planner": Param(str, "navigator", "navigation graph of the onboard map, or GBPlanner2's global graph",
                          choices=("navigator", "gbplanner")),

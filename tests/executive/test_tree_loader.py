@@ -237,5 +237,5 @@ def test_skill_param_checks(tmp_path):
     with pytest.raises(DelveError, match=r"t.yaml:2: parameter 'range_m' must be >= 0.0, got -1 \[node 'Fragile'\]"):
         check_tree(path, registry=fragile_registry())
     path = write(tmp_path, "u.yaml", "type: Fragile\nrange_m: 1\ntarget: ' '\n")
-    with pytest.raises(DelveError, match="blackboard key name"):
+    with pytest.raises(DelveError, match="must be a blackboard key"):
         check_tree(path, registry=fragile_registry())
