@@ -117,7 +117,7 @@ def run(path: Path, out: Path | None, seed: int | None, duration_s: float | None
     ``include_path``: folders the trees' includes may also resolve into."""
     from .outputs import write_outputs
     from .runner import Mission
-    from .scenario import load_scenario, steps_problem
+    from .scenario import load_scenario, steps_problem, warn_late_events
 
     if seed is not None and seed < 0:
         raise DelveError(f"--seed must be >= 0, got {seed}")
@@ -126,6 +126,8 @@ def run(path: Path, out: Path | None, seed: int | None, duration_s: float | None
     scenario = load_scenario(path, include_path=include_path)
     if duration_s is not None and steps_problem(duration_s, scenario.dt_s):
         raise DelveError(f"--duration-s {steps_problem(duration_s, scenario.dt_s)}")
+    if duration_s is not None and duration_s < scenario.duration_s:  # those after the file's end were named
+        warn_late_events(scenario.doc, scenario.path, duration_s, scenario.duration_s, "--duration-s")
     out = out or Path("delve-out") / scenario.name
     check_out_dir(out)
     started = time.perf_counter()

@@ -99,3 +99,13 @@ class DelveDeprecation(UserWarning):
 
 
 warnings.simplefilter("always", DelveDeprecation)
+
+
+class DelveWarning(UserWarning):
+    """A file asks for something that will not happen as written (a supervisor
+    command timed after the end of the run, say); the run goes on. The message
+    starts with the file and the line of the key at fault; the CLI prints it as one
+    ``warning:`` line."""
+
+
+warnings.simplefilter("always", DelveWarning)

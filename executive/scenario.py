@@ -14,7 +14,7 @@ from typing import Any, Iterable
 
 import jsonschema
 
-from .errors import DelveDeprecation, DelveError, did_you_mean
+from .errors import DelveDeprecation, DelveError, DelveWarning, did_you_mean, display_path
 from .faults import Fault, FaultContext
 from .faults.loader import load_faults
 from .supervisor import Command, load_supervisor
@@ -214,6 +214,25 @@ def _check_steps(doc: YamlDict, path: Path, duration_s: float, dt_s: float) -> N
     raise DelveError(f"{key}: {problem}", path, doc.key_line(key) or doc.line)
 
 
+def warn_late_events(doc: YamlDict, path: Path, duration_s: float, until_s: float = math.inf,
+                     where: str = "duration_s") -> None:
+    """A :class:`DelveWarning` for each supervisor command and fault of ``doc``
+    timed after ``duration_s`` (and at most ``until_s``): it never happens."""
+    for section, what in (("supervisor", "supervisor command"), ("faults", "fault")):
+        items = doc.get(section)
+        if not isinstance(items, YamlList):
+            continue
+        for item in items:
+            at = item.get("at_s") if isinstance(item, YamlDict) else None
+            if isinstance(at, bool) or not isinstance(at, (int, float)) or not duration_s < at <= until_s:
+                continue
+            name = item.get("command") or item.get("kind")
+            label = f" {short_repr(name)}" if isinstance(name, str) else ""
+            warnings.warn(DelveWarning(
+                f"{display_path(path)}:{item.key_line('at_s')}: {what}{label} at_s {at:g} comes after the end of "
+                f"the run ({where} {duration_s:g} s): it never happens"), stacklevel=2)
+
+
 def _world_backend(doc: YamlDict, path: Path) -> type[WorldBackend]:
     """The backend that claims the scenario's ``world:``; a DelveError if none does."""
     world = doc["world"]
@@ -320,6 +339,7 @@ def load_scenario(path: str | Path, include_path: Iterable[str | Path] = ()) -> 
                                                          base_tree is not None))
     values = {k: doc.get(k, v) for k, v in DEFAULTS.items()}
     _check_steps(doc, path, float(values["duration_s"]), float(values["dt_s"]))
+    warn_late_events(doc, path, float(values["duration_s"]))
     backend.check(doc, path, base_tree is not None)
     team = _team(doc, path, tree_types)
     if team.strategy.NEEDS_BASE_TREE and base_tree is None:

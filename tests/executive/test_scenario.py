@@ -60,3 +60,63 @@ def test_load_errors_are_delve_errors(tmp_path):
     bad.write_text("- just\n- a list\n")
     with pytest.raises(DelveError, match="must be a mapping"):
         load_scenario(bad)
+
+
+LATE = """name: late
+duration_s: 100
+world:
+  generator: tunnel_network
+  total_length_m: 120
+  loops: 1
+robots:
+  - name: anymal
+    platform: legged
+    tree: {tree}
+supervisor:
+  - at_s: 50
+    robot: anymal
+    command: home
+  - at_s: 500
+    robot: anymal
+    command: home
+faults:
+  - at_s: 200
+    duration_s: 10
+    kind: lidar_dropout
+    robot: anymal
+"""
+
+
+def late_scenario(tmp_path):
+    from delve import TREES_DIR
+
+    path = tmp_path / "late.yaml"
+    path.write_text(LATE.format(tree=TREES_DIR / "frontier_explorer.yaml"))
+    return path
+
+
+def test_commands_and_faults_after_the_end_warn_with_file_and_line(tmp_path):
+    from delve.executive.errors import DelveWarning
+
+    with pytest.warns(DelveWarning) as caught:
+        load_scenario(late_scenario(tmp_path))
+    messages = [str(w.message) for w in caught if w.category is DelveWarning]
+    assert len(messages) == 2
+    assert messages[0].endswith("late.yaml:15: supervisor command 'home' at_s 500 comes after the end of the run "
+                                "(duration_s 100 s): it never happens")
+    assert "late.yaml:19: fault 'lidar_dropout' at_s 200 comes after the end" in messages[1]
+
+
+def test_cli_prints_late_events_as_one_line_warnings(tmp_path, monkeypatch, capsys):
+    from delve.executive.scenario import Scenario
+
+    def stop(*args, **kwargs):
+        raise DelveError("stopped before the world")
+
+    monkeypatch.setattr(Scenario, "build_world", stop)
+    assert main(["run", str(late_scenario(tmp_path)), "--duration-s", "40", "--quiet", "--out",
+                 str(tmp_path / "out")]) == 2
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert [line.split(": ", 1)[0] for line in lines[:3]] == ["warning"] * 3
+    assert "at_s 50 comes after the end of the run (--duration-s 40 s)" in lines[2]
+    assert lines[3] == "stopped before the world" and len(lines) == 4
