@@ -33,7 +33,7 @@ def test_clusters_form_a_tree_that_covers_the_active_network():
 
 def test_clustered_cycle_returns_valid_plans_on_a_bigger_network():
     net = spread_team_network(40, 4, seed=3)
-    opts = SolverOptions(time_limit_s=3, probe_time_limit_s=1, mip_gap=0.05)
+    opts = SolverOptions(mip_gap=0.05)
     cyc = plan_cycle_clustered(net, max_cluster_locations=12, options=opts)
     assert cyc.meta["clusters"] >= 2
     assert validate_plan(net, cyc.pre) == []

@@ -15,10 +15,11 @@ def test_a_cycle_passes_the_validator():
 
 def test_greedy_plans_bound_the_horizon_and_warm_start_the_solver():
     net = fork(team(4))
-    cyc = plan_cycle(net, clustering=False, options=SolverOptions(time_limit_s=2, total_time_limit_s=4))
+    cyc = plan_cycle(net, clustering=False, options=SolverOptions(total_work=4000))
     assert validate_plan(net, cyc.pre) == []
     # trimmed after the last action: the last step moves someone or sends something
     T = cyc.pre.horizon
     last_moves = any(tr[T - 1] != tr[T] for tr in cyc.pre.trajectories.values())
     assert last_moves or any(c.t == T for c in cyc.pre.communications)
-    assert cyc.pre.meta["status"] in ("optimal", "feasible") and cyc.meta["solve_time_s"] < 8
+    assert cyc.pre.meta["status"] in ("optimal", "feasible")
+    assert cyc.meta["solves"] >= 2 and cyc.meta["safety_stops"] == 0 and cyc.meta["work"] >= 0

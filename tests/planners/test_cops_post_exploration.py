@@ -30,7 +30,7 @@ def test_infeasible_problems_say_why_in_one_line():
     net = cut_off()
     with pytest.raises(InfeasibleProblem) as err:
         solve_post_exploration(net, sources=["r1"], masters=["base", "r1"], max_horizon=2,
-                               options=SolverOptions(probe_time_limit_s=2))
+                               options=SolverOptions(probe_max_work=30.0))
     assert str(err.value) == "no route to the base within horizon T=2 for robot r1"
     with pytest.raises(InfeasibleProblem) as err:
         solve_post_exploration(net, sources=["r2"], masters=["base", "r2"])
