@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
+from py_trees.common import Status
 from delve.executive.runner import Mission
 from delve.executive.scenario import load_scenario
 
@@ -152,5 +153,8 @@ def test_goto_fails_with_no_path_for_a_goal_inside_rock(tmp_path):
     mission.run()
     (failed,) = events(mission, "goto_failed")
     assert failed["goto_failure"] == "no_path"
-    assert mission.succeeded  # the tree handled it
+    robot = next(a for n, a in mission.agents.items() if n != "base")
+    assert robot.root.status == Status.SUCCESS  # the tree handled it
+    # ... but a robot that stayed home is no successful mission, and the console says why.
+    assert not mission.succeeded and "never left its start" in mission.outcome.reasons[0]
     assert mission.clock.now_s < 5.0
