@@ -5,8 +5,9 @@ Every mistake becomes a one-line :class:`DelveError` with the file and line.
 from __future__ import annotations
 
 import json
-import warnings
 import math
+import os
+import warnings
 from dataclasses import dataclass, field
 from functools import lru_cache
 from pathlib import Path
@@ -233,6 +234,26 @@ def warn_late_events(doc: YamlDict, path: Path, duration_s: float, until_s: floa
                 f"the run ({where} {duration_s:g} s): it never happens"), stacklevel=2)
 
 
+def _tree_file(path: Path, given: str, include_path: tuple[Path, ...], what: str, line: int | None) -> Path:
+    """The tree file ``given`` names (relative to the scenario ``path``), resolved: it
+    must lie, symbolic links followed, in the scenario's folder, the shipped trees or
+    an ``include_path`` folder (the rule of includes), and be a readable file."""
+    from .tree_loader import allowed_include_roots, path_inside
+
+    where = path.parent / given
+    if "\0" not in given:
+        roots = allowed_include_roots(path, include_path)
+        if not any(path_inside(os.path.realpath(where), root) for root in roots):
+            folders = ", ".join([f"the scenario's folder {os.path.join(display_path(roots[0]), '')}",
+                                 "the shipped trees", *(display_path(r) for r in roots[2:])])
+            raise DelveError(f"{what} {short_repr(given)} is outside the allowed folders ({folders}; "
+                             "add --include-path)", path, line)
+    problem = file_problem(where)
+    if problem:
+        raise DelveError(f"{what} file {problem}: {short_repr(given)[1:-1]}", path, line)
+    return where.resolve()
+
+
 def _world_backend(doc: YamlDict, path: Path) -> type[WorldBackend]:
     """The backend that claims the scenario's ``world:``; a DelveError if none does."""
     world = doc["world"]
@@ -312,11 +333,7 @@ def load_scenario(path: str | Path, include_path: Iterable[str | Path] = ()) -> 
             why = "is used twice" if r["name"] in names else "is reserved for the base station"
             raise DelveError(f"robot name {short_repr(r['name'])} {why}", path, line)
         names.add(r["name"])
-        problem = file_problem(path.parent / r["tree"])
-        if problem:
-            raise DelveError(f"robot {short_repr(r['name'])}: tree file {problem}: {short_repr(r['tree'])[1:-1]}",
-                             path, r.key_line("tree"))
-        tree = (path.parent / r["tree"]).resolve()
+        tree = _tree_file(path, r["tree"], include_path, f"robot {short_repr(r['name'])}: tree", r.key_line("tree"))
         robot_types[r["name"]] = check_tree(tree, include_path=include_path)
         tree_types |= robot_types[r["name"]]
         extra = {k: float(r[k]) for k in ("speed_mps", "max_inclination_deg", "max_step_m") if k in r}
@@ -328,11 +345,7 @@ def load_scenario(path: str | Path, include_path: Iterable[str | Path] = ()) -> 
     base = doc.get("base_station", {})
     base_tree = None
     if "tree" in base:
-        problem = file_problem(path.parent / base["tree"])
-        if problem:
-            raise DelveError(f"base station tree file {problem}: {short_repr(base['tree'])[1:-1]}", path,
-                             base.key_line("tree"))
-        base_tree = (path.parent / base["tree"]).resolve()
+        base_tree = _tree_file(path, base["tree"], include_path, "base station tree", base.key_line("tree"))
         tree_types |= check_tree(base_tree, include_path=include_path)
     supervisor = load_supervisor(doc.get("supervisor"), path, {r.name: r.breadcrumbs for r in robots})
     faults = load_faults(doc.get("faults"), FaultContext(path, {r.name: r for r in robots}, robot_types, backend,

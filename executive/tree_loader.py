@@ -39,7 +39,8 @@ from .errors import DelveError, clip_message, did_you_mean, display_path
 from .registry import Build, NodeType, Registry, Site, coerce_param, default_registry
 from .yamlio import YamlDict, YamlList, file_problem, line_of, line_of_key_named, load_yaml
 
-__all__ = ["MAX_TREE_DEPTH", "build_tree", "check_context", "check_tree", "compose_remap", "load_tree"]
+__all__ = ["MAX_TREE_DEPTH", "allowed_include_roots", "build_tree", "check_context", "check_tree", "compose_remap",
+           "load_tree", "path_inside"]
 
 _INCLUDE_KEYS = ("include", "remap", "name")
 #: Deepest a tree may nest, nodes within nodes, includes counted (the shipped trees
@@ -86,7 +87,8 @@ def allowed_include_roots(tree_file: str | os.PathLike[str] | None,
     return tuple(dict.fromkeys(roots))
 
 
-def _inside(path: str, root: str) -> bool:
+def path_inside(path: str, root: str) -> bool:
+    """Whether the real path ``path`` lies in the folder ``root`` (also real)."""
     try:
         return os.path.commonpath([path, root]) == root
     except ValueError:  # another drive on Windows
@@ -212,7 +214,7 @@ class _TreeBuilder:
         base = os.path.dirname(file) if file else ""
         path = os.path.normpath(os.path.join(base, target))
         real = os.path.realpath(path)
-        if not any(_inside(real, root) for root in self.roots):
+        if not any(path_inside(real, root) for root in self.roots):
             folders = ", ".join([f"the tree's folder {os.path.join(display_path(self.roots[0]), '')}",
                                  "the shipped trees", *(display_path(r) for r in self.roots[2:])])
             site.fail(f"include {short_repr(target)} is outside the allowed folders ({folders}; add --include-path)",

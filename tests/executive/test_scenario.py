@@ -120,3 +120,21 @@ def test_cli_prints_late_events_as_one_line_warnings(tmp_path, monkeypatch, caps
     assert [line.split(": ", 1)[0] for line in lines[:3]] == ["warning"] * 3
     assert "at_s 50 comes after the end of the run (--duration-s 40 s)" in lines[2]
     assert lines[3] == "stopped before the world" and len(lines) == 4
+
+
+def test_a_scenario_tree_resolves_only_in_its_folder_the_shipped_trees_or_include_path(tmp_path):
+    (tmp_path / "mission").mkdir()
+    (tmp_path / "mytrees").mkdir()
+    (tmp_path / "mytrees" / "explorer.yaml").write_text("type: Sequence\nchildren:\n  - type: Success\n")
+    path = tmp_path / "mission" / "s.yaml"
+    path.write_text("name: s\nworld: {generator: tunnel_network, total_length_m: 120, loops: 1}\n"
+                    "robots:\n  - name: anymal\n    platform: legged\n    tree: ../mytrees/explorer.yaml\n")
+    with pytest.raises(DelveError, match=r"s.yaml:6: robot 'anymal': tree '../mytrees/explorer.yaml' is outside "
+                                         r"the allowed folders .*add --include-path"):
+        load_scenario(path)
+    scenario = load_scenario(path, include_path=[tmp_path / "mytrees"])
+    assert scenario.robots[0].tree == (tmp_path / "mytrees" / "explorer.yaml").resolve()
+    (tmp_path / "mission" / "link.yaml").symlink_to(tmp_path / "mytrees" / "explorer.yaml")
+    path.write_text(path.read_text().replace("../mytrees/explorer.yaml", "link.yaml"))
+    with pytest.raises(DelveError, match="is outside the allowed folders"):
+        load_scenario(path)

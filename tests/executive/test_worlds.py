@@ -61,7 +61,7 @@ robots:
   - {{name: a, platform: legged, tree: {DATA.parents[2] / 'trees' / 'cops_robot.yaml'}, tick_hz: 1.0}}
   - {{name: c, platform: legged, tree: {DATA.parents[2] / 'trees' / 'cops_robot.yaml'}, tick_hz: 1.0}}
 """)
-    sc = load_scenario(scenario)
+    sc = load_scenario(scenario, include_path=[DATA])
     assert sc.world_backend is ForkBackend
     mission = Mission(sc)
     mission.run()
@@ -84,5 +84,5 @@ robots:
 """)
     from delve.executive.errors import DelveError
     with pytest.raises(DelveError, match="'range_m' does not apply to a graph world") as err:
-        load_scenario(bad)
+        load_scenario(bad, include_path=[DATA])
     assert err.value.line == 5
