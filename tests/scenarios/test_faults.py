@@ -2,7 +2,6 @@
 fault takes hold when it starts, lets go when it ends, and the mission survives it
 (or ends honestly when it cannot). Slow (see conftest.py)."""
 import json
-import shutil
 from pathlib import Path
 
 import numpy as np
@@ -207,7 +206,8 @@ def test_a_base_station_restart_keeps_its_map_and_loses_its_blackboard(tmp_path)
 def test_a_cops_base_station_restart_replans_and_the_team_finishes(data_dir, tmp_path):
     text = (data_dir / "cops_fork.yaml").read_text().replace("cops_fork_network.yaml",
                                                               str(data_dir / "cops_fork_network.yaml"))
-    shutil.copy(data_dir / "cops_base_fast.yaml", tmp_path)  # a scenario's trees stay in its folder
+    base = (data_dir / "cops_base_fast.yaml").read_text().replace("../../../trees/", f"{TREES}/")
+    (tmp_path / "cops_base_fast.yaml").write_text(base)  # a scenario's trees stay in its folder
     text = text.replace("../../../trees/", f"{TREES}/")
     path = tmp_path / "cops_fork_restart.yaml"
     path.write_text(text + "faults:\n  - {at_s: 150, kind: base_restart, duration_s: 30}\n")
