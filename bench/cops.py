@@ -29,7 +29,7 @@ from dataclasses import replace
 
 from delve.planners.cops import (PlanningError, SolverOptions, available_solver, plan_cycle,
                                  validate_plan)
-from delve.planners.cops.budget import Meter
+from delve.planners.cops.meter import Meter
 from delve.planners.cops.clustering import should_cluster
 from delve.planners.cops.network import spread_team_network
 

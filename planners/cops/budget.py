@@ -11,11 +11,11 @@ caller can report a result that may not be reproducible.
 """
 from __future__ import annotations
 
-import threading
 import time
 from dataclasses import dataclass, replace
 
 from .ilp_problem import SolverOptions
+from .meter import Meter
 
 #: However little work is left, a solve that must run (the plan at the horizon found)
 #: gets this much checkpoint work: presolve, the root LP and a round or two after it.
@@ -24,33 +24,6 @@ MIN_SOLVE_WORK = 3
 MIN_SAFETY_S = 1.0
 #: Share of a cycle's work budget given to pre-exploration (post-exploration gets the rest).
 PRE_SHARE = 0.55
-
-
-class Meter:
-    """Work done by the solves of a planning call (simplex iterations, solves) and the
-    safety stops that fired, each also counted in the enclosing call's meter
-    (``parent``). Thread-safe: clusters are solved at once."""
-
-    def __init__(self, parent: Meter | None = None) -> None:
-        self.parent = parent
-        self.work = 0
-        self.solves = 0
-        self.safety_stops: list[str] = []
-        self._lock = threading.Lock()
-
-    def add(self, work: int = 0, solves: int = 0, safety_stop: str | None = None) -> None:
-        m: Meter | None = self
-        while m is not None:
-            with m._lock:
-                m.work += int(work)
-                m.solves += solves
-                if safety_stop:
-                    m.safety_stops.append(safety_stop)
-            m = m.parent
-
-    def figures(self) -> dict:
-        """``work``, ``solves`` and ``safety_stops`` (a count), for a plan's meta."""
-        return {"work": self.work, "solves": self.solves, "safety_stops": len(self.safety_stops)}
 
 
 @dataclass(frozen=True)

@@ -9,7 +9,7 @@ from .network import MCNetwork
 from .plan import Requirement
 
 if TYPE_CHECKING:
-    from .budget import Meter
+    from .meter import Meter
 
 
 @dataclass(frozen=True)
@@ -41,7 +41,7 @@ class SolverOptions:
     expected: ``time_limit_s`` per solve (``probe_time_limit_s`` per probe) and
     ``total_time_limit_s`` per planning call. They are generous, and a result
     that one of them cut short may differ from run to run: every one that fires
-    is counted (``meter``, :class:`~.budget.Meter`) and reported.
+    is counted (``meter``, :class:`~.meter.Meter`) and reported.
     """
 
     mip_gap: float | None = 0.01

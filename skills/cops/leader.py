@@ -11,7 +11,7 @@ from py_trees.common import Status
 
 from ...planners.cops import (MASTER, CyclePlan, PlanningError, SolverOptions, plan_cycle,
                               solve_post_exploration, validate_plan)
-from ...planners.cops.budget import Meter
+from ...planners.cops.meter import Meter
 from ...planners.cops.plan import idle_plan
 from ...planners.cops.recall import solve_recall
 from ...planners.cops.topology import Topology, team_network

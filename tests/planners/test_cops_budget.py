@@ -3,7 +3,8 @@ meter of work and safety stops, and the safety stop of a call."""
 import time
 
 from delve.planners.cops import SolverOptions
-from delve.planners.cops.budget import MIN_SAFETY_S, MIN_SOLVE_WORK, Budget, Meter, SolveLimits
+from delve.planners.cops.budget import MIN_SAFETY_S, MIN_SOLVE_WORK, Budget, SolveLimits
+from delve.planners.cops.meter import Meter
 
 
 def test_without_a_total_every_solve_gets_its_own_limits():

@@ -4,7 +4,8 @@ import pytest
 
 from delve.planners.cops import (ConnectivityProblem, FrontierReward, Requirement, SolverOptions,
                                  SolverTimeout, available_solver, solve_connectivity, validate_plan)
-from delve.planners.cops.budget import Meter, SolveLimits
+from delve.planners.cops.budget import SolveLimits
+from delve.planners.cops.meter import Meter
 from delve.planners.cops.greedy import greedy_pre_plan
 from delve.planners.cops.horizon import horizon_of
 from delve.planners.cops.ilp_solvers import _cbc_figures
