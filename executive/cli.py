@@ -208,7 +208,8 @@ def _run_with_progress(mission) -> None:
 def validate(files: list[Path], include_path: tuple[Path, ...] = ()) -> int:
     """Check each file (a scenario when its top level has a scenario's keys, or near
     misses of them; else a tree); print ``ok`` or the error. Exit 2 if any file is wrong."""
-    from .scenario import load_scenario, scenario_keys
+    from .document_kind import scenario_keys
+    from .scenario import load_scenario
     from .tree_loader import check_tree
 
     status = 0

@@ -13,6 +13,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from .outcome import mission_outcome  # noqa: E402
 from .render import render_tree  # noqa: E402
 from .runner import Mission  # noqa: E402
 from .teams import wall_clock_fields  # noqa: E402
@@ -23,6 +24,7 @@ WALL_CLOCK_FIELDS = ("wall_time_s", "real_time_factor")
 
 def report(mission: Mission, wall_time_s: float) -> dict[str, Any]:
     """The run's figures (see DESIGN.md, "Outputs of a run")."""
+    outcome = mission_outcome(mission)
     last = mission.state.samples[-1]
     triggers: dict[str, Counter] = {n: Counter() for n in mission.robots}
     for e in mission.state.events:
@@ -49,8 +51,8 @@ def report(mission: Mission, wall_time_s: float) -> dict[str, Any]:
     return {
         "scenario": mission.scenario.name,
         "seed": mission.seed,
-        "succeeded": mission.succeeded,
-        "outcome": mission.outcome.to_dict(),
+        "succeeded": outcome.succeeded,
+        "outcome": outcome.to_dict(),
         "sim_time_s": round(sim_time, 3),
         "wall_time_s": round(wall_time_s, 3),
         "real_time_factor": round(sim_time / wall_time_s, 1) if wall_time_s > 0 else None,

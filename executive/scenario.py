@@ -16,8 +16,8 @@ from typing import Any, Iterable
 import jsonschema
 
 from .errors import DelveDeprecation, DelveError, DelveWarning, did_you_mean, display_path
-from .faults import Fault, FaultContext
-from .faults.loader import load_faults
+from .document_kind import scenario_keys
+from .faults import Fault, FaultContext, load_faults
 from .supervisor import Command, load_supervisor
 from .teams import DEFAULT_STRATEGY, TEAM_STRATEGIES, TeamStrategy, implied_strategy
 from .worlds import WorldBackend, backend_for, generator_names
@@ -122,22 +122,6 @@ class Scenario:
             if problem:
                 raise DelveError(f"base station position is {problem}", self.path,
                                  self.doc["base_station"].key_line("position"))
-
-
-#: Top-level keys that only a scenario has (a tree node may have a name too).
-_SCENARIO_ONLY_KEYS = ("world", "robots", "base_station", "radio", "team", "supervisor", "faults")
-
-
-def scenario_keys(mapping: Any) -> list[str]:
-    """The keys that make ``mapping`` (a file's top level) a scenario rather than a
-    tree: keys only a scenario has, or near misses of them (``wrold``), in file order.
-    [] for a tree node (it has, or nearly has, 'type' or 'include')."""
-    if not isinstance(mapping, dict):
-        return []
-    keys = [k for k in mapping if isinstance(k, str)]
-    if any(k in ("type", "include") or did_you_mean(k, ("type", "include")) for k in keys):
-        return []
-    return [k for k in keys if k in _SCENARIO_ONLY_KEYS or did_you_mean(k, _SCENARIO_ONLY_KEYS)]
 
 
 def _where(path: Any) -> str:

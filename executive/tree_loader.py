@@ -35,6 +35,7 @@ from py_trees.behaviour import Behaviour
 
 from .. import TREES_DIR
 from ..skills.base import KEY_PATTERN, KEY_RULE, AgentContext, Skill, short_repr
+from .document_kind import scenario_keys
 from .errors import DelveError, clip_message, did_you_mean, display_path
 from .registry import Build, NodeType, Registry, Site, coerce_param, default_registry
 from .yamlio import YamlDict, YamlList, file_problem, line_of, line_of_key_named, load_yaml
@@ -147,8 +148,6 @@ class _TreeBuilder:
         that names it, if any)."""
         if not isinstance(data, Mapping) or "type" in data or "include" in data:
             return
-        from .scenario import scenario_keys
-
         keys = scenario_keys(data)
         if not keys:
             return

@@ -30,5 +30,9 @@ for _kind in (Stuck, MapArtifact, Lost, RadioBlackout, LidarDegraded, LidarDropo
               BatteryDrop, LocalisationDrift, BreadcrumbDies, BaseRestart):
     register_fault(_kind)
 
-__all__ = ["BASE_STATION", "FAULT_KINDS", "Fault", "FaultContext", "InjectedPlannerError", "LINK", "NEVER",
-           "OPTIONAL", "REQUIRED", "ROBOT", "Target", "register_fault"]
+# After the registry: the loader and the schedule look kinds up in it.
+from .loader import load_faults  # noqa: E402
+from .schedule import FaultSchedule  # noqa: E402
+
+__all__ = ["BASE_STATION", "FAULT_KINDS", "Fault", "FaultContext", "FaultSchedule", "InjectedPlannerError", "LINK",
+           "NEVER", "OPTIONAL", "REQUIRED", "ROBOT", "Target", "load_faults", "register_fault"]
