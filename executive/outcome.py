@@ -38,8 +38,6 @@ MIN_DISTANCE_M = 1.0
 MIN_PROGRESS_FRACTION = 0.02
 #: ... when at least this share was left to explore at the start.
 MUCH_LEFT_FRACTION = 0.10
-#: Events in which behaviours say why they failed (besides every ``*_failed``).
-FAILURE_EVENTS = ("cops_no_plan", "cops_invalid_plan", "return_without_plan")
 #: Events that end a robot's exploration, well or not.
 EXPLORATION_ENDS = ("explore_failed", "exploration_complete", "planner_homing", "endurance_low",
                     "homing_timer")
@@ -73,16 +71,22 @@ def failing_node(root: py_trees.behaviour.Behaviour) -> py_trees.behaviour.Behav
         node = failed[-1] if isinstance(node, py_trees.composites.Selector) else failed[0]
 
 
-def failure_event(events: list[dict[str, Any]], agent: str) -> str | None:
+def is_failure(event: dict[str, Any], failure_events: tuple[str, ...] = ()) -> bool:
+    """Whether a behaviour says in ``event`` why it failed: every ``*_failed`` event,
+    and the team strategy's own (``TeamStrategy.FAILURE_EVENTS``)."""
+    return event["event"].endswith("_failed") or event["event"] in failure_events
+
+
+def failure_event(events: list[dict[str, Any]], agent: str, failure_events: tuple[str, ...] = ()) -> str | None:
     """The last failure an agent's behaviours logged, as ``event: reason, detail``."""
     for e in reversed(events):
-        if e.get("agent") == agent and (e["event"].endswith("_failed") or e["event"] in FAILURE_EVENTS):
+        if e.get("agent") == agent and is_failure(e, failure_events):
             words = [str(e[k]) for k in ("reason", "detail") if e.get(k) not in (None, "")]
             return e["event"] + (": " + ", ".join(words) if words else "")
     return None
 
 
-def _last_word(events: list[dict[str, Any]], agent: str) -> str | None:
+def _last_word(events: list[dict[str, Any]], agent: str, failure_events: tuple[str, ...]) -> str | None:
     """Why a robot that ended well did nothing: its last failure or exploration end."""
     for e in reversed(events):
         if e.get("agent") != agent:
@@ -90,8 +94,8 @@ def _last_word(events: list[dict[str, Any]], agent: str) -> str | None:
         if e["event"] == "exploration_complete":
             crumbs = e.get("blacklisted_voxels")
             return "exploration complete" + (f" with {crumbs} frontier voxels blacklisted" if crumbs else "")
-        if e["event"].endswith("_failed") or e["event"] in FAILURE_EVENTS:
-            return failure_event([e], agent)
+        if is_failure(e, failure_events):
+            return failure_event([e], agent, failure_events)
     return None
 
 
@@ -108,7 +112,7 @@ def agent_reason(mission: "Mission", agent: "Agent", timed_out: bool) -> str:
     status = agent.root.status
     if status == Status.FAILURE:
         node = failing_node(agent.root)
-        why = failure_event(mission.state.events, agent.name)
+        why = failure_event(mission.state.events, agent.name, mission.team.FAILURE_EVENTS)
         feedback = node.feedback_message if node.feedback_message not in (why or "") else ""
         return (f"{agent.name}: FAILURE at {node.name!r}" + (f" ({feedback})" if feedback else "")
                 + (f": {why}" if why else ""))
@@ -132,7 +136,7 @@ def mission_outcome(mission: "Mission") -> Outcome:
         reasons.append(f"every robot was lost: {lost}")
     for name, robot in mission.robots.items():
         if name not in mission.lost and robot.distance_m < MIN_DISTANCE_M:
-            word = _last_word(mission.state.events, name)
+            word = _last_word(mission.state.events, name, mission.team.FAILURE_EVENTS)
             reasons.append(f"{name}: never left its start ({robot.distance_m:.1f} m travelled)"
                            + (f"; {word}" if word else ""))
     samples = mission.state.samples

@@ -29,6 +29,9 @@ class TeamStrategy(ABC):
     PARAMS: ClassVar[dict[str, Param]] = {}
     #: Report fields of this strategy that depend on the wall clock.
     WALL_CLOCK_FIELDS: ClassVar[tuple[str, ...]] = ()
+    #: Events (besides every ``*_failed``) in which the strategy's behaviours say why
+    #: they failed; the mission's outcome quotes them.
+    FAILURE_EVENTS: ClassVar[tuple[str, ...]] = ()
     #: Whether the strategy needs a base station tree.
     NEEDS_BASE_TREE: ClassVar[bool] = False
 

@@ -40,6 +40,7 @@ class Cops(TeamStrategy):
                                                      "locations (voxel worlds' lattice cell), metres",
                               exclusive_minimum=0.0, maximum=1e3)}
     WALL_CLOCK_FIELDS = ("cops_solve_time_s",)
+    FAILURE_EVENTS = ("cops_no_plan", "cops_invalid_plan", "return_without_plan")
     NEEDS_BASE_TREE = True
 
     def __init__(self, **params: Any):
