@@ -101,7 +101,6 @@ def t_reach(samples: list, fraction: float) -> float | None:
 def run_world(job: tuple[str, dict, int]) -> list[Run]:
     """Both planners on one world and seed (the world is generated once)."""
     import numpy as np
-    from delve.executive.outcome import mission_outcome
     from delve.executive.runner import Mission
     from delve.executive.scenario import load_scenario
 
@@ -122,7 +121,7 @@ def run_world(job: tuple[str, dict, int]) -> list[Run]:
             robot = mission.robots["anymal"]
             out.append(Run(name, seed, planner, t_reach(mission.state.samples, TARGET),
                            t_reach(mission.state.samples, TARGET_LOW), mission.state.samples[-1].team, mission.clock.now_s, robot.distance_m,
-                           bool(np.linalg.norm(robot.position - robot.home) <= 1.5), mission_outcome(mission).succeeded, wall))
+                           bool(np.linalg.norm(robot.position - robot.home) <= 1.5), mission.succeeded, wall))
     return out
 
 

@@ -23,14 +23,14 @@ console shows. ``delve run`` prints both, and ``report.json`` holds them under
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Protocol
 
 import py_trees
 from py_trees.common import Status
 
 if TYPE_CHECKING:
     from .agent import Agent
-    from .runner import Mission
+    from .teams import TeamStrategy
 
 #: A robot that travelled less than this never left its start (m).
 MIN_DISTANCE_M = 1.0
@@ -107,7 +107,19 @@ def exploration_failure(events: list[dict[str, Any]], agent: str) -> str | None:
     return failure_event([last], agent) if last is not None and last["event"] == "explore_failed" else None
 
 
-def agent_reason(mission: "Mission", agent: "Agent", timed_out: bool) -> str:
+class Judged(Protocol):
+    """What the outcome reads of a mission (a :class:`~delve.executive.runner.Mission`)."""
+
+    duration_s: float
+    lost: dict[str, str]
+    robots: dict[str, Any]
+    robot_agents: list[Agent]
+    state: Any  # MissionState: its events and coverage samples
+    team: TeamStrategy
+    timed_out: bool
+
+
+def agent_reason(mission: Judged, agent: "Agent", timed_out: bool) -> str:
     """One line: why ``agent``'s tree did not end in SUCCESS."""
     status = agent.root.status
     if status == Status.FAILURE:
@@ -121,7 +133,7 @@ def agent_reason(mission: "Mission", agent: "Agent", timed_out: bool) -> str:
     return f"{agent.name}: had not finished {when}"
 
 
-def mission_outcome(mission: "Mission") -> Outcome:
+def mission_outcome(mission: Judged) -> Outcome:
     """The :class:`Outcome` of a finished mission (see the module docstring)."""
     timed_out = bool(mission.timed_out)
     reasons: list[str] = []

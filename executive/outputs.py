@@ -13,7 +13,6 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from .outcome import mission_outcome  # noqa: E402
 from .render import render_tree  # noqa: E402
 from .runner import Mission  # noqa: E402
 from .teams import wall_clock_fields  # noqa: E402
@@ -24,7 +23,7 @@ WALL_CLOCK_FIELDS = ("wall_time_s", "real_time_factor")
 
 def report(mission: Mission, wall_time_s: float) -> dict[str, Any]:
     """The run's figures (see DESIGN.md, "Outputs of a run")."""
-    outcome = mission_outcome(mission)
+    outcome = mission.outcome
     last = mission.state.samples[-1]
     triggers: dict[str, Counter] = {n: Counter() for n in mission.robots}
     for e in mission.state.events:

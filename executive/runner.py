@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 from collections import deque
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Any, Callable
 
 import numpy as np
@@ -21,6 +22,7 @@ from ..skills.base import AgentContext
 from ..skills.operator import COMMAND
 from .agent import Agent
 from .faults import FaultSchedule
+from .outcome import Outcome, mission_outcome
 from .scenario import Scenario
 from .tree_loader import load_tree
 from .worlds import BASE, WorldBackend
@@ -229,3 +231,15 @@ class Mission:
             positions={n: [round(float(v), 3) for v in r.position] for n, r in self.robots.items()},
             linked={n: self.radio.linked(n, BASE) for n in self.robots},
         ))
+
+    # ---- results ----------------------------------------------------------------
+    @cached_property
+    def outcome(self) -> Outcome:
+        """Whether the mission succeeded and why not (asked once it is over): its team
+        strategy's judgement and the mission-level checks (:mod:`.outcome`)."""
+        return mission_outcome(self)
+
+    @property
+    def succeeded(self) -> bool:
+        """Whether the mission succeeded (:attr:`outcome`)."""
+        return self.outcome.succeeded
