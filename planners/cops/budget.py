@@ -35,13 +35,15 @@ class SolveLimits:
     max_work: float | None = None
     stall_work: float | None = None
     time_limit_s: float | None = None
+    max_rows: int | None = None
 
     @classmethod
     def of(cls, opts: SolverOptions, probe: bool = False) -> SolveLimits:
         """The limits ``opts`` give a solve (a feasibility probe: ``probe``)."""
         if probe:
-            return cls(opts.probe_max_nodes, opts.probe_max_work, None, opts.probe_time_limit_s)
-        return cls(opts.max_nodes, opts.max_work, opts.stall_work, opts.time_limit_s)
+            return cls(opts.probe_max_nodes, opts.probe_max_work, None, opts.probe_time_limit_s,
+                       opts.search_max_rows)
+        return cls(opts.max_nodes, opts.max_work, opts.stall_work, opts.time_limit_s, opts.search_max_rows)
 
 
 class Budget:

@@ -23,14 +23,17 @@ class SolverOptions:
     **Work limits** bound every result, so that the same problem gives the same plan
     on a quiet machine and on a busy one (:mod:`.budget`). HiGHS calls back at fixed
     points of its search, its *checkpoints*: after presolve, after each round of cuts
-    at the root, and after each node or dive of the tree. A checkpoint counts as
-    *checkpoint work* the model's rows in thousands (at least 1): a round or a node
-    costs about that much more on a larger model. A solve stops after ``max_nodes``
+    at the root, and after each node or dive of the tree. A checkpoint after the root
+    LP counts as *checkpoint work* (rows / 2000)², at least 1: a round or a node
+    re-solves the LP, with more and dearer simplex iterations on a larger model
+    (:func:`~.ilp_solvers.checkpoint_weight`). A solve stops after ``max_nodes``
     branch-and-bound nodes or ``max_work`` checkpoint work (feasibility probes of the
     horizon searches: ``probe_max_nodes``, ``probe_max_work``), and a solve that
     holds a plan stops when the plan has not improved for ``stall_work`` (nor for half
     the work it took to find it). The root LP is not cut: HiGHS calls back before and
-    after it, never during it. ``total_work`` bounds one planning call
+    after it, never during it; so a warm-started model of more than
+    ``search_max_rows`` rows, whose root LP alone would take tens of seconds, is not
+    searched (its completed warm start is the plan). ``total_work`` bounds one planning call
     (``plan_cycle``, ``solve_pre_exploration``, ``solve_post_exploration``,
     ``solve_recall``) in simplex iterations summed over its solves: once it is spent
     no further probe or horizon is tried, and a solve that must still run (at the
@@ -49,10 +52,11 @@ class SolverOptions:
     threads: int = 1
     workers: int = 2
     max_nodes: int | None = 500
-    max_work: float | None = 600.0
-    stall_work: float | None = 100.0
+    max_work: float | None = 400.0
+    stall_work: float | None = 60.0
     probe_max_nodes: int | None = 100
-    probe_max_work: float | None = 60.0
+    probe_max_work: float | None = 40.0
+    search_max_rows: int | None = 30000
     total_work: int | None = 12000
     time_limit_s: float | None = 300.0
     probe_time_limit_s: float | None = 50.0

@@ -12,8 +12,8 @@ def test_without_a_total_every_solve_gets_its_own_limits():
                          probe_time_limit_s=2.0, total_time_limit_s=None)
     budget = Budget(opts)
     assert budget.left() is None and not budget.spent()
-    assert budget.limits() == SolveLimits(opts.max_nodes, 70.0, opts.stall_work, 7.0)
-    assert budget.limits(probe=True) == SolveLimits(opts.probe_max_nodes, 20.0, None, 2.0)
+    assert budget.limits() == SolveLimits(opts.max_nodes, 70.0, opts.stall_work, 7.0, opts.search_max_rows)
+    assert budget.limits(probe=True) == SolveLimits(opts.probe_max_nodes, 20.0, None, 2.0, opts.search_max_rows)
     assert budget.options(0.5).total_work is None
 
 

@@ -31,10 +31,14 @@ def test_cbc_gives_the_same_optimum():
     assert a.meta["objective"] == pytest.approx(b.meta["objective"])
 
 
+def plan_network():
+    return spread_team_network(25, 4, 1)
+
+
 def spread_problem(**kw):
     """Pre-exploration of 25 locations with four robots, warm-started by the greedy plan:
     large enough that a search does not finish at the root (about 7000 rows)."""
-    net = spread_team_network(25, 4, 1)
+    net = plan_network()
     pos, static = net.positions(), net.static_robots()
     explorers = net.explorers() - static
     rewards = {s: FrontierReward().marginals(len(explorers)) for s in net.frontiers}
@@ -76,3 +80,9 @@ def test_cbc_reports_its_work_and_the_limit_that_stopped_it():
     assert _cbc_figures("Result - Stopped on time limit\n")[2] == "safety"
     optimal = "Result - Optimal solution found\nEnumerated nodes: 0\nTotal iterations: 7\n"
     assert _cbc_figures(optimal) == (7, 0, None)
+
+
+def test_a_model_too_large_to_search_gives_its_completed_warm_start():
+    plan = solve_connectivity(spread_problem(options=SolverOptions(search_max_rows=100)))
+    assert plan.meta["stop"] == "size" and plan.meta["status"] == "feasible" and plan.meta["gap"] is None
+    assert validate_plan(plan_network(), plan) == []
