@@ -24,7 +24,7 @@ class SolverOptions:
     on a quiet machine and on a busy one (:mod:`.budget`). HiGHS calls back at fixed
     points of its search, its *checkpoints*: after presolve, after each round of cuts
     at the root, and after each node or dive of the tree. A checkpoint after the root
-    LP counts as *checkpoint work* (rows / 2000)², at least 1: a round or a node
+    LP counts as *checkpoint work* (rows / 2000)², at least 0.5: a round or a node
     re-solves the LP, with more and dearer simplex iterations on a larger model
     (:func:`~.ilp_solvers.checkpoint_weight`). A solve stops after ``max_nodes``
     branch-and-bound nodes or ``max_work`` checkpoint work (feasibility probes of the
@@ -52,8 +52,8 @@ class SolverOptions:
     threads: int = 1
     workers: int = 2
     max_nodes: int | None = 500
-    max_work: float | None = 400.0
-    stall_work: float | None = 60.0
+    max_work: float | None = 300.0
+    stall_work: float | None = 30.0
     probe_max_nodes: int | None = 100
     probe_max_work: float | None = 40.0
     search_max_rows: int | None = 30000

@@ -304,10 +304,11 @@ def solve_highs(model: ConnectivityModel, opts: SolverOptions, limits: SolveLimi
 
 def checkpoint_weight(rows: int) -> float:
     """The work of one checkpoint of a model with ``rows`` rows: (rows / 2000)², at least
-    1. A round of cuts or a node re-solves the LP: each simplex iteration costs more on a
-    larger model, and a larger model takes more of them (measured on COPS models: about
-    10 ms a checkpoint at 500 rows, 25 ms at 2000, 0.1 s at 5000, 0.5 s at 10 000)."""
-    return max(1.0, (rows / 2000.0) ** 2)
+    0.5. A round of cuts or a node re-solves the LP: each simplex iteration costs more on
+    a larger model, and a larger model takes more of them (measured on COPS models:
+    about 10 ms a checkpoint at 500 rows, 25 ms at 2000, 0.1 s at 5000, 0.5 s at
+    10 000)."""
+    return max(0.5, (rows / 2000.0) ** 2)
 
 
 def _int_limit(n: int | None) -> int:
