@@ -23,6 +23,8 @@ request stays, and the next run starts it again.
 """
 from __future__ import annotations
 
+from abc import abstractmethod
+
 import math
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
@@ -159,8 +161,9 @@ class InspectionStep(Skill):
         super().__init__(name, ctx, remap, **params)
         self.state = inspection_state(ctx)
 
+    @abstractmethod
     def step(self, job: InspectionJob) -> Status:
-        raise NotImplementedError
+        """This step's part of the inspection ``job``."""
 
     def update(self) -> Status:
         job = self.state.job

@@ -7,6 +7,8 @@ says only where it is going (:meth:`~PathMotion.reached`), where its path comes 
 """
 from __future__ import annotations
 
+from abc import abstractmethod
+
 from typing import Any
 
 import numpy as np
@@ -62,13 +64,13 @@ class PathMotion(Skill):
         a status ends the behaviour; None goes on (give up, or re-plan)."""
         return None
 
+    @abstractmethod
     def give_up(self, status: PathStatus, reason: str) -> Status:
         """More than ``max_replans`` re-plans: ``reason`` is the robot's blocked reason."""
-        raise NotImplementedError
 
+    @abstractmethod
     def plan(self) -> Status:
         """Issue the next path with :meth:`drive` and return RUNNING, or end the behaviour."""
-        raise NotImplementedError
 
     # ---- the loop ------------------------------------------------------------------
     def initialise(self) -> None:

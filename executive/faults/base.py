@@ -12,6 +12,8 @@ A new kind subclasses :class:`Fault` and calls
 """
 from __future__ import annotations
 
+from abc import ABC, abstractmethod
+
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, ClassVar
 
@@ -67,7 +69,7 @@ class FaultContext:
     has_base_tree: bool
 
 
-class Fault:
+class Fault(ABC):
     """One fault of a scenario: a kind, a time, a target, maybe an end, parameters.
 
     Subclasses set ``KIND`` (the name a scenario gives), ``TARGETS`` (any of
@@ -115,9 +117,9 @@ class Fault:
                 **({"duration_s": self.duration_s} if self.duration_s is not None else {}), **self.p}
 
     # ---- the mission ----------------------------------------------------------------
+    @abstractmethod
     def start(self, mission: "Mission") -> dict[str, Any]:
         """Inject the fault at ``at_s``; returns extra fields for its ``fault`` event."""
-        raise NotImplementedError
 
     def step(self, mission: "Mission", now_s: float) -> None:
         """Called at every step while the fault lasts (after :meth:`start`, until

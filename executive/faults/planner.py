@@ -11,6 +11,8 @@ fault that starts before it takes hold as soon as it exists.
 """
 from __future__ import annotations
 
+from abc import abstractmethod
+
 from typing import TYPE_CHECKING, Any, Callable
 
 from ...skills.base import Param
@@ -73,8 +75,9 @@ class _PlannerFault(Fault):
         self._release()
         return {"plans_hit": self.hits}
 
+    @abstractmethod
     def _wrap(self, plan: Callable[..., Any], mission: "Mission") -> Callable[..., Any]:
-        raise NotImplementedError
+        """The planner's ``plan`` as this fault makes it behave."""
 
 
 class PlannerError(_PlannerFault):
