@@ -18,7 +18,7 @@ import math
 import os
 import sys
 from pathlib import Path
-from typing import Iterator, Sequence
+from typing import Any, Iterator, Sequence
 
 import networkx as nx
 import numpy as np
@@ -218,14 +218,19 @@ def from_mesh(path: str | Path, *, scale: float = 1.0, up_axis: str = "z",
     verts = (np.asarray(mesh.vertices) * scale) @ rot.T
     world_mesh = o3d.geometry.TriangleMesh(o3d.utility.Vector3dVector(verts),
                                            o3d.utility.Vector3iVector(np.asarray(mesh.triangles)))
-    world = closed_mesh_world(world_mesh, v, name or path.stem)
-    if start is not None:
-        world.start = np.asarray(start, dtype=float).reshape(3)
-        problem = world.start_problem(world.start)
-        if problem:
-            raise ValueError(f"start {world.start.tolist()} in mesh world '{path}': {problem}")
-    else:
+    return place_start(closed_mesh_world(world_mesh, v, name or path.stem), start, f"mesh world '{path}'")
+
+
+def place_start(world: World, start: Any, where: str) -> World:
+    """Set ``world.start`` to ``start`` (checked: a ValueError naming ``where`` when no
+    robot can stand there), or to :func:`default_start` when none is given."""
+    if start is None:
         world.start = default_start(world)
+        return world
+    world.start = np.asarray(start, dtype=float).reshape(3)
+    problem = world.start_problem(world.start)
+    if problem:
+        raise ValueError(f"start {world.start.tolist()} in {where}: {problem}")
     return world
 
 

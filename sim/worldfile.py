@@ -38,7 +38,7 @@ import open3d as o3d
 from . import freespace
 from .geometry_io import Geometry, read_geometry
 from .limits import DEFAULT_VOXEL_SIZE_M, check_voxels, voxel_count
-from .meshio import closed_mesh_world, default_start, up_axis_rotation
+from .meshio import closed_mesh_world, place_start, up_axis_rotation
 from .world import World, WorldSource
 from .worldgen_geometry import free_space_mesh
 
@@ -86,14 +86,7 @@ def from_file(path: str | Path, *, scale: float | None = None, up_axis: str | No
                               points, rot, factor, path)
     else:
         world = _mesh_world(geo, verts, v, name, src, ceiling_m, points)
-    if start is not None:
-        world.start = np.asarray(start, dtype=float).reshape(3)
-        problem = world.start_problem(world.start)
-        if problem:
-            raise ValueError(f"start {world.start.tolist()} in world file '{path.name}': {problem}")
-    else:
-        world.start = default_start(world)
-    return world
+    return place_start(world, start, f"world file '{path.name}'")
 
 
 def _check_size(verts: np.ndarray, v: float, ceiling_m: float | None, file: str, scaled: bool,
