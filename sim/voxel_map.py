@@ -17,7 +17,10 @@ OCCUPIED = 1
 class VoxelMap:
     """Dense int8 occupancy grid with change tracking for map sharing.
 
-    Implements the ``MapView`` protocol of ``delve.skills.robot``.
+    Implements the ``MapView`` protocol of ``delve.skills.robot``. Memory: one byte
+    per voxel of the world's grid for ``occupancy`` (planners read it as a dense
+    array, with flat indices over the world grid), one bit per voxel for the
+    changes not yet taken, and the flat indices of the FREE voxels.
     """
 
     def __init__(self, shape: tuple[int, int, int], origin: np.ndarray, voxel_size_m: float):
@@ -25,7 +28,9 @@ class VoxelMap:
         self.origin = np.asarray(origin, dtype=float)
         self.voxel_size_m = float(voxel_size_m)
         self.version = 0
-        self._dirty = np.zeros(shape, dtype=bool)
+        #: Changed voxels not yet taken, one bit each (bit ``f % 8`` of byte ``f // 8``
+        #: for flat index ``f``): an eighth of a bool grid.
+        self._dirty = np.zeros((self.occupancy.size + 7) // 8, dtype=np.uint8)
         self._free = np.zeros(0, dtype=np.int64)
         self._new_free: list[np.ndarray] = []
         self._free_stale = False
@@ -78,7 +83,11 @@ class VoxelMap:
         else:
             self._free_stale = True
         occ[flat] = value
-        self._dirty.reshape(-1)[flat] = True
+        self._touch(flat)
+
+    def _touch(self, flat: np.ndarray) -> None:
+        """Record voxels ``flat`` as changed."""
+        np.bitwise_or.at(self._dirty, flat >> 3, np.left_shift(1, flat & 7).astype(np.uint8))
 
     def set_sphere(self, centre: np.ndarray, radius_m: float, value: int) -> None:
         """Set every voxel within ``radius_m`` of ``centre`` to ``value``."""
@@ -93,7 +102,7 @@ class VoxelMap:
         inside = (i >= 0) & (i < nx) & (j >= 0) & (j < ny) & (k >= 0) & (k < nz)
         flat = ((i * ny + j) * nz + k)[inside]
         self.occupancy.reshape(-1)[flat] = value
-        self._dirty.reshape(-1)[flat] = True
+        self._touch(flat)
         self._free_stale = True
         self._refreed = True  # a voxel set here may be freed again by a later scan
         self.version += 1
@@ -114,9 +123,12 @@ class VoxelMap:
         return self._free
 
     def take_changes(self) -> tuple[np.ndarray, np.ndarray]:
-        """Flat indices and values of the voxels changed since the last call."""
-        flat = np.flatnonzero(self._dirty)
-        self._dirty.reshape(-1)[flat] = False
+        """Flat indices (ascending) and values of the voxels changed since the last call."""
+        byte = np.flatnonzero(self._dirty)
+        bits = np.unpackbits(self._dirty[byte][:, None], axis=1, bitorder="little")
+        row, bit = np.nonzero(bits)
+        flat = byte[row] * 8 + bit
+        self._dirty[byte] = 0
         return flat, self.occupancy.reshape(-1)[flat].copy()
 
     def merge(self, flat: np.ndarray, values: np.ndarray) -> None:

@@ -285,8 +285,17 @@ class World:
         return int(self._region_labels()[tuple(int(i) for i in idx)])
 
     def _region_labels(self) -> np.ndarray:
+        """The free space's region labels (cached), in the smallest unsigned dtype that
+        holds them: labelled into uint16 first, so that a large world never holds
+        the int32 grid scipy would otherwise return (4 bytes a voxel)."""
         if self._labels is None:
-            labels, n = ndimage.label(self.free, structure=_CONNECTIVITY_26)
+            labels = np.empty(self.free.shape, dtype=np.uint16)
+            try:
+                n = ndimage.label(self.free, structure=_CONNECTIVITY_26, output=labels)
+            except RuntimeError as err:       # more than 65535 regions: scipy's own int32
+                if "bit-depth" not in str(err):
+                    raise
+                labels, n = ndimage.label(self.free, structure=_CONNECTIVITY_26)
             self._labels = labels.astype(np.min_scalar_type(n), copy=False)
         return self._labels
 

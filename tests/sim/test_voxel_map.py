@@ -53,3 +53,59 @@ def test_free_voxels_track_scans_resets_and_rescans_without_duplicates():
     again = m.free_voxels()
     assert len(np.unique(again)) == len(again)
     assert np.array_equal(np.sort(again), np.sort(first))
+
+
+class _DenseChanges(VoxelMap):
+    """The change log as it was: one bool per voxel (the reference for the bit log)."""
+
+    def __init__(self, *args):
+        super().__init__(*args)
+        self._dense = np.zeros(self.occupancy.size, dtype=bool)
+
+    def _touch(self, flat):
+        self._dense[flat] = True
+
+    def take_changes(self):
+        flat = np.flatnonzero(self._dense)
+        self._dense[flat] = False
+        return flat, self.occupancy.reshape(-1)[flat].copy()
+
+
+def test_bit_change_log_takes_what_a_bool_grid_would_on_random_updates():
+    rng = np.random.default_rng(5)
+    shape, origin = (23, 17, 11), np.array([-1.0, -2.0, 0.5])   # 4301 voxels: not a multiple of 8
+    bits, dense = VoxelMap(shape, origin, 0.2), _DenseChanges(shape, origin, 0.2)
+    lo, hi = origin, origin + np.array(shape) * 0.2
+    taken = 0
+    for step in range(60):
+        kind = rng.integers(4)
+        if kind < 2:
+            sensor = rng.uniform(lo - 0.5, hi + 0.5)          # sometimes outside the grid
+            dirs = rng.normal(size=(40, 3))
+            dirs /= np.linalg.norm(dirs, axis=1, keepdims=True)
+            ranges = np.where(rng.random(40) < 0.7, rng.uniform(0.1, 4.0, 40), np.inf)
+            for m in (bits, dense):
+                m.integrate_scan(sensor, dirs, ranges, 3.0)
+        elif kind == 2:
+            centre, value = rng.uniform(lo, hi), int(rng.integers(-1, 2))
+            for m in (bits, dense):
+                m.set_sphere(centre, 0.5, value)
+        else:
+            (fa, va), (fd, vd) = bits.take_changes(), dense.take_changes()
+            np.testing.assert_array_equal(fa, fd)
+            np.testing.assert_array_equal(va, vd)
+            taken += len(fa)
+        np.testing.assert_array_equal(bits.occupancy, dense.occupancy)
+    (fa, va), (fd, vd) = bits.take_changes(), dense.take_changes()
+    np.testing.assert_array_equal(fa, fd)
+    np.testing.assert_array_equal(va, vd)
+    assert taken + len(fa) > 100 and bits.occupancy.size - 1 in range(bits._dirty.size * 8)
+    assert len(bits.take_changes()[0]) == 0
+
+
+def test_change_log_holds_the_last_voxel_of_the_grid():
+    m = VoxelMap((3, 3, 3), np.zeros(3), 1.0)
+    m.set_sphere(np.array([2.5, 2.5, 2.5]), 0.1, OCCUPIED)
+    flat, values = m.take_changes()
+    assert flat.tolist() == [26] and values.tolist() == [OCCUPIED]
+    assert m._dirty.nbytes == 4                      # 27 voxels, one bit each

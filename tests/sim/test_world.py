@@ -6,6 +6,7 @@ import networkx as nx
 import numpy as np
 import open3d as o3d
 import pytest
+from scipy import ndimage
 
 from delve.sim.world import World
 from delve.sim.worldgen_geometry import (VoxelCanvas, carve_chamber, carve_tunnel,
@@ -238,3 +239,18 @@ def test_pickle_and_copy(twin):
         assert len(clone.mesh.triangles) == len(twin.mesh.triangles)
         o, d = np.array([[15.0, 0.0, 1.0]]), np.array([[0.0, 1.0, 0.0]])
         assert clone.cast_rays(o, d, 10.0)[0] == pytest.approx(twin.cast_rays(o, d, 10.0)[0])
+
+
+@pytest.mark.parametrize("shape, step, dtype", [((40, 40, 40), 8, np.uint8), ((44, 44, 44), 4, np.uint16),
+                                                ((600, 500, 1), 2, np.uint32)])
+def test_region_labels_are_scipys_in_the_smallest_dtype(shape, step, dtype):
+    """Isolated free voxels every ``step`` voxels: 125, 1331 and 75 000 regions; the
+    labels equal scipy's int32 ones, in uint8, uint16 and (over 65535 regions) uint32."""
+    free = np.zeros(shape, dtype=bool)
+    free[::step, ::step, ::step] = True
+    world = World(name="dots", origin=np.zeros(3), free=free, mesh=o3d.geometry.TriangleMesh(),
+                  start=np.zeros(3))
+    labels, sizes = world.free_regions()
+    expected, n = ndimage.label(free, structure=np.ones((3, 3, 3), dtype=bool))
+    np.testing.assert_array_equal(labels, expected)
+    assert labels.dtype == dtype and len(sizes) == n + 1 == np.count_nonzero(free) + 1
