@@ -89,12 +89,22 @@ def _check_size(total: float, width: tuple[float, float], height: tuple[float, f
                  "total_length_m", volume / DEFAULT_VOXEL_SIZE_M ** 3)
 
 
+def region_sites(region_m: tuple, spacing_m: float) -> list:
+    """Lattice index ranges [(i0, i1), (j0, j1)] of the sites within an area of
+    ``region_m`` (x, y) metres: from the portal along +x, centred on it in y."""
+    if not isinstance(region_m, (list, tuple)) or len(region_m) != 2:
+        raise ValueError(f"region_m must be an (x, y) pair of metres, got {region_m!r}")
+    x, y = (_check_positive("region_m", r) for r in region_m)
+    ni, nj = int(x // spacing_m) + 1, int(y // spacing_m) + 1
+    return [(0, ni), (-(nj // 2), nj - nj // 2)]
+
+
 # ========================================================== generators
 def tunnel_network(seed: int, *, total_length_m: float = 400.0, spacing_m: float = 20.0,
                    levels: int = 1, shaft: bool = False, ramp: bool = True, loops: int = 2,
                    max_slope_deg: float = 30.0, width_m: tuple = (3.0, 5.0),
                    height_m: tuple = (2.5, 3.5), voxel_size_m: float = 0.2,
-                   name: str = "tunnel_network") -> World:
+                   region_m: tuple | None = None, name: str = "tunnel_network") -> World:
     """A seeded mine: a jittered-lattice network of flat-floored, arch-roofed tunnels.
 
     A random spanning tree grows on a lattice of ``spacing_m`` from the start
@@ -107,7 +117,10 @@ def tunnel_network(seed: int, *, total_length_m: float = 400.0, spacing_m: float
     first, joined by a long ramp (``ramp=True``) and/or a vertical shaft
     (``shaft=True``); ``levels=1, shaft=True`` adds a shaft up to a small
     dead-end gallery that only a flying robot can reach. Nodes carry ``level``
-    0 or 1. Raises ValueError for impossible parameters.
+    0 or 1. ``region_m`` (x, y) is the area the lattice grows in, from the portal
+    along +x and centred on it in y (default: a square roomy enough for
+    ``total_length_m``); a network too long for it widens it. Raises ValueError
+    for impossible parameters.
     """
     total = _check_positive("total_length_m", total_length_m)
     spacing = _check_positive("spacing_m", spacing_m)
@@ -127,6 +140,7 @@ def tunnel_network(seed: int, *, total_length_m: float = 400.0, spacing_m: float
                          f"use at least {2 * width[1] + CLEARANCE_M} m")
     if levels == 2 and not (ramp or shaft):
         raise ValueError("levels=2 needs ramp=True and/or shaft=True to join the two levels")
+    sites = None if region_m is None else region_sites(region_m, spacing)
 
     rng = np.random.default_rng(seed)
     plan = MinePlan(rng, spacing, v, math.radians(slope_deg), width, height)
@@ -146,7 +160,7 @@ def tunnel_network(seed: int, *, total_length_m: float = 400.0, spacing_m: float
     phase1 = max(total - extras - levels * spacing, min(total, 2.0 * spacing))
 
     plan.add_node([0.0, 0.0, 0.0], 0, (0, 0))
-    region = mine_regions(int(math.ceil(total / spacing)))
+    region = mine_regions(int(math.ceil(total / spacing))) if sites is None else sites
 
     def compact(site):      # favour filling in, so lattice neighbours for loops exist
         near = sum(plan.sites[0].get((site[0] + d[0], site[1] + d[1]), -1) >= 0

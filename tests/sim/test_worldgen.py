@@ -261,11 +261,24 @@ def test_single_level_shaft_to_gallery():
     (dict(loops=-1), "loops"),
     (dict(spacing_m=5.0), "spacing_m"),
     (dict(total_length_m=30.0, loops=3), "loop"),
+    (dict(region_m=(60.0,)), "region_m"),
+    (dict(region_m=(60.0, -1.0)), "region_m"),
 ])
 def test_mine_rejects_impossible_parameters(kwargs, message):
     params = {**SMALL_MINE, **kwargs}
     with pytest.raises(ValueError, match=message):
         worldgen.tunnel_network(0, **params)
+
+
+def test_mine_grows_within_its_region():
+    """A network given a long, narrow region fills it: about 60 m along x and
+    200 m across y (plus the tunnels' half widths and the grid's margin)."""
+    world = worldgen.tunnel_network(3, total_length_m=700.0, spacing_m=20.0, loops=1,
+                                    region_m=(60.0, 200.0))
+    pos = np.array([p for _, p in world.centreline.nodes(data="pos")])
+    assert pos[:, 0].min() > -5 and pos[:, 0].max() < 65
+    assert pos[:, 1].min() > -105 and pos[:, 1].max() < 105
+    assert pos[:, 1].max() - pos[:, 1].min() > 2 * (pos[:, 0].max() - pos[:, 0].min())
 
 
 # -------------------------------------------------------------------- cave
