@@ -30,6 +30,16 @@
   clipping the corner of a cell, a second passage through a cell) are not lost:
   the locations that one connected fragment of them touches are joined pairwise.
   An edge's length is the distance between the positions.
+* **Open areas** (:mod:`delve.planners.cops.regions`): cells side by side whose
+  locations' free space touches through open space (a horizontal disc of
+  ``open_radius_m`` fits there: wider than a tunnel) are merged into one location,
+  a region of at most ``max_region_m`` across, named after its member nearest cell
+  (0, 0, 0); ``keep`` cells are never merged, ``prior`` merges (a ``merged`` map)
+  always hold. A region's position is its member's position nearest the mean of
+  its members' positions; it is explored when a member is; its edges are its
+  members' edges to other locations, with lengths between positions. The
+  topology's ``merged`` maps every member to its region. ``open_radius_m=None``
+  merges nothing (the lattice's cells alone).
 * The dense steps run on the box of the known-free voxels only (plus a margin for
   the frontier test), so their cost follows the mapped part of the world.
 * A communication edge (~>) joins two locations whose *sight points* (positions
@@ -49,6 +59,7 @@ from scipy.spatial import cKDTree
 
 from ..frontier import FRONTIER_DEPTH, frontier_voxels
 from ..occupancy import FREE, Grid
+from .regions import DEFAULT_MAX_REGION_M, DEFAULT_OPEN_RADIUS_M, group_cells, open_faces, open_space
 from .topology import Topology
 
 #: Edge of a lattice cell (one location per cell), metres.
@@ -86,6 +97,10 @@ def extract_topology(
     visited: np.ndarray | None = None,
     lattice_origin: np.ndarray | None = None,
     passable: np.ndarray | None = None,
+    open_radius_m: float | None = DEFAULT_OPEN_RADIUS_M,
+    max_region_m: float = DEFAULT_MAX_REGION_M,
+    prior: dict[str, str] | None = None,
+    keep: tuple[str, ...] | list[str] = (),
 ) -> Topology:
     """The topology (locations, explored ones, mobility and communication edges) of a map.
 
@@ -98,10 +113,16 @@ def extract_topology(
     ``min_free_voxels`` and become positions; ``free`` the flat indices of the FREE voxels when the map
     keeps them (the frontier search then needs no scan of the grid); ``visited``
     (N, 3) world points where robots have been; ``lattice_origin`` the lattice's
-    corner (default: the world's origin). Raises ``ValueError`` for bad inputs.
+    corner (default: the world's origin); ``open_radius_m``, ``max_region_m``,
+    ``prior`` and ``keep`` shape the regions of open areas (see above). Raises
+    ``ValueError`` for bad inputs.
     """
     grid = _checked_grid(occupancy, origin, voxel_size_m, free)
     _check_parameters(cell_m, comm_range_m, min_free_voxels, sight_height_m)
+    if open_radius_m is not None and not _positive(open_radius_m):
+        raise ValueError(f"open_radius_m must be a positive finite number or None, got {open_radius_m!r}")
+    if not _positive(max_region_m):
+        raise ValueError(f"max_region_m must be a positive finite number, got {max_region_m!r}")
     corner = _checked_point(lattice_origin, "lattice_origin")
     visited_cells = _visited_cells(visited, cell_m, corner)
     standable = _checked_mask(grid, standable, "standable")
@@ -129,15 +150,28 @@ def extract_topology(
                            corner + (lattice + 0.5) * cell_m)
     explored = ~np.isin(location_keys, _frontier_cell_keys(grid, partition))
     explored |= [tuple(c) in visited_cells for c in lattice.tolist()]
-    for name, pos, done in zip(names, positions, explored):
-        topo.add_location(name, pos, explored=bool(done))
     mobility = _mobility_pairs(_touching_components(labels, partition), location_of)
+    merged: dict[str, str] = {}
+    if open_radius_m is not None:
+        opened = open_faces(labels, partition, open_space(mask | passable_mask, grid.voxel_size_m, open_radius_m))
+        loc = location_of[opened]
+        merged = group_cells(names, lattice, loc[np.all(loc >= 0, axis=1)], cell_m=cell_m,
+                             max_region_m=max_region_m, prior=prior, keep=keep)
+    region = np.array([merged.get(n, n) for n in names])
+    names, index = np.unique(region, return_inverse=True)
+    positions = _region_positions(positions, index, len(names))
+    explored = np.bincount(index, weights=explored, minlength=len(names)) > 0
+    mobility = _unique_pairs(index[mobility])
+    mobility = mobility[mobility[:, 0] != mobility[:, 1]]
+    topo.merged = merged
+    for name, pos, done in zip(names.tolist(), positions, explored):
+        topo.add_location(name, pos, explored=bool(done))
     lengths = np.linalg.norm(positions[mobility[:, 0]] - positions[mobility[:, 1]], axis=1)
     for (a, b), length in zip(mobility.tolist(), lengths.tolist()):
-        topo.add_mobility_edge(names[a], names[b], length)
+        topo.add_mobility_edge(str(names[a]), str(names[b]), length)
     sight = positions + np.array([0.0, 0.0, sight_height_m])
     for a, b in _communication_pairs(grid, sight, comm_range_m, mobility).tolist():
-        topo.add_communication_edge(names[a], names[b])
+        topo.add_communication_edge(str(names[a]), str(names[b]))
     return topo
 
 
@@ -313,6 +347,17 @@ def _positions(world: np.ndarray, location: np.ndarray, centres: np.ndarray) -> 
     order = tied[np.lexsort((world[tied, 2], world[tied, 1], world[tied, 0], location[tied]))]
     _, first = np.unique(location[order], return_index=True)
     return world[order[first]]
+
+
+def _region_positions(positions: np.ndarray, region: np.ndarray, n: int) -> np.ndarray:
+    """(n, 3): per region, the position of its member (rows of ``positions``, region
+    ``region``) nearest the mean of its members' positions; ties go to the first."""
+    mean = np.stack([np.bincount(region, weights=positions[:, a], minlength=n) for a in range(3)], axis=1)
+    mean /= np.bincount(region, minlength=n)[:, None]
+    gap = np.round(np.linalg.norm(positions - mean[region], axis=1) / _DISTANCE_ROUNDING_M)
+    order = np.lexsort((np.arange(len(region)), gap, region))
+    _, first = np.unique(region[order], return_index=True)
+    return positions[order[first]]
 
 
 def _frontier_cell_keys(grid: Grid, partition: list[np.ndarray]) -> np.ndarray:

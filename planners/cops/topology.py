@@ -10,6 +10,12 @@ so the base station merges what comes back in any order.
 locations with the edges among them; a frontier is an explored location with a
 mobility edge to a location nobody has explored yet.
 
+On voxel worlds a location may be a *region* of lattice cells merged into one
+open area (:mod:`delve.planners.cops.regions`); ``merged`` maps each member cell
+that is not its region's name to that name. Merging two topologies merges regions
+that share a cell and renames what is known of the members, so a name once used
+always resolves (:meth:`Topology.resolve`).
+
 Plain data: the dict form (``to_dict`` / ``from_dict``) is what robots send over
 the radio and what the simulator's graph world reports.
 """
@@ -19,7 +25,10 @@ import math
 from dataclasses import dataclass, field
 from typing import Any, Iterable, Mapping
 
+from networkx.utils import UnionFind
+
 from .network import DEFAULT_COMMUNICATION_COST, MCNetwork, Robot
+from .regions import region_name
 
 
 def _pair(u: str, v: str) -> tuple[str, str]:
@@ -40,6 +49,7 @@ class Topology:
     mobility: dict[tuple[str, str], float] = field(default_factory=dict)
     communication: set[tuple[str, str]] = field(default_factory=set)
     unreachable: set[str] = field(default_factory=set)
+    merged: dict[str, str] = field(default_factory=dict)
 
     # -- building -------------------------------------------------------------------
     def add_location(self, name: str, pos: Iterable[float], explored: bool = False) -> None:
@@ -65,7 +75,10 @@ class Topology:
             self.communication.add(_pair(u, v))
 
     def merge(self, other: "Topology") -> bool:
-        """Add everything ``other`` knows; True when something was new."""
+        """Add everything ``other`` knows; True when something was new. Regions of
+        both that share a cell become one, named by
+        :func:`delve.planners.cops.regions.region_name`, and what either knew of a
+        member is known of the region."""
         before = self.size()
         for name, pos in other.locations.items():
             self.locations.setdefault(name, pos)
@@ -74,15 +87,51 @@ class Topology:
             self.mobility.setdefault(e, length)
         self.communication |= other.communication
         self.unreachable |= other.unreachable
+        if other.merged or self.merged:
+            self._merge_regions(other.merged)
         return self.size() != before
+
+    def _merge_regions(self, merged: Mapping[str, str]) -> None:
+        """Join the regions of ``self.merged`` and ``merged``, then rename members."""
+        regions = UnionFind()
+        for member, name in sorted([*self.merged.items(), *merged.items()]):
+            regions.union(member, name)
+        self.merged = {m: region_name(group) for group in regions.to_sets() for m in sorted(group)}
+        self.merged = {m: n for m, n in sorted(self.merged.items()) if m != n}
+        if not self.merged.keys() & (self.locations.keys() | self.unreachable):
+            return
+        rename = self.resolve
+        for name in sorted(self.locations):
+            if rename(name) != name:
+                pos = self.locations.pop(name)
+                self.locations.setdefault(rename(name), pos)
+        self.explored = {rename(s) for s in self.explored}
+        self.unreachable = {rename(s) for s in self.unreachable}
+        mobility: dict[tuple[str, str], float] = {}
+        for (u, v), length in sorted(self.mobility.items()):
+            a, b = rename(u), rename(v)
+            if a != b:
+                mobility.setdefault(_pair(a, b), length)
+        self.mobility = mobility
+        self.communication = {_pair(rename(u), rename(v)) for u, v in self.communication if rename(u) != rename(v)}
+
+    def resolve(self, name: str) -> str:
+        """The location a name stands for now: its region's name for a member of a
+        merged location, else the name itself."""
+        return self.merged.get(name, name)
+
+    def members(self, name: str) -> list[str]:
+        """The names a location has had: itself and its region's other members, sorted."""
+        head = self.resolve(name)
+        return sorted({head, *(m for m, n in self.merged.items() if n == head)})
 
     def copy(self) -> "Topology":
         return Topology(dict(self.locations), set(self.explored), dict(self.mobility), set(self.communication),
-                        set(self.unreachable))
+                        set(self.unreachable), dict(self.merged))
 
-    def size(self) -> tuple[int, int, int, int, int]:
+    def size(self) -> tuple[int, int, int, int, int, int]:
         return (len(self.locations), len(self.explored), len(self.mobility), len(self.communication),
-                len(self.unreachable))
+                len(self.unreachable), len(self.merged))
 
     # -- queries ----------------------------------------------------------------------
     def neighbours(self, location: str) -> list[str]:
@@ -131,7 +180,8 @@ class Topology:
                 "explored": sorted(self.explored),
                 "mobility": [[u, v, round(length, 3)] for (u, v), length in sorted(self.mobility.items())],
                 "communication": [list(e) for e in sorted(self.communication)],
-                "unreachable": sorted(self.unreachable)}
+                "unreachable": sorted(self.unreachable), **({"merged": dict(sorted(self.merged.items()))}
+                                                            if self.merged else {})}
 
     @classmethod
     def from_dict(cls, d: Mapping[str, Any]) -> "Topology":
@@ -155,6 +205,8 @@ class Topology:
                 if s not in topo.locations:
                     raise ValueError(f"unreachable location '{s}' is not a location")
                 topo.unreachable.add(str(s))
+            for member, name in dict(d.get("merged", {})).items():
+                topo.merged[str(member)] = str(name)
         except (TypeError, IndexError, AttributeError) as err:
             raise ValueError(f"malformed topology: {err}") from None
         return topo

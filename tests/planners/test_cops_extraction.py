@@ -143,7 +143,7 @@ def test_unconnected_parallel_rooms_in_neighbouring_cells_are_not_joined():
 
 def test_empty_map_has_no_locations():
     occ = np.full((10, 10, 10), UNKNOWN, dtype=np.int8)
-    assert extract_topology(occ, np.zeros(3), V).size() == (0, 0, 0, 0, 0)
+    assert extract_topology(occ, np.zeros(3), V).size() == (0,) * 6
 
 
 @pytest.mark.parametrize("kwargs, message", [
