@@ -4,6 +4,7 @@
     delve validate FILE... | --shipped [--include-path DIR]...
     delve render TREE --format svg|dot|png|txt [--out PATH] [--include-path DIR]...
     delve world SCENARIO [--preview DIR] [--seed N] [--include-path DIR]...
+    delve sweep SWEEP [--out DIR] [--workers N | --scheduler ADDRESS] [--retry-failed] [--quiet]
     delve demo
 
 Exit status: 0 when the mission succeeds (every robot's tree ends in SUCCESS, every
@@ -49,7 +50,16 @@ def _parser() -> argparse.ArgumentParser:
     wld.add_argument("scenario", type=Path, help="a scenario file, or the name of a shipped one")
     wld.add_argument("--preview", type=Path, metavar="DIR", help="also draw top.png and side.png into DIR")
     wld.add_argument("--seed", type=int, help="override the scenario's seed (generated worlds)")
-    for command in (run, val, ren, wld):
+    swp = sub.add_parser("sweep", help="run every run of a sweep file (scenarios x overrides x seeds) on Dask "
+                                       "and write one table and plots (docs/sweeps.md)")
+    swp.add_argument("sweep", type=Path, help="a sweep file")
+    swp.add_argument("--out", type=Path, help="output directory (default: delve-out/<sweep name>)")
+    swp.add_argument("--workers", type=int, help="worker processes of the local cluster (default: one per core)")
+    swp.add_argument("--scheduler", metavar="ADDRESS", help="run on the Dask cluster at ADDRESS (tcp://host:8786) "
+                                                            "instead of a local one")
+    swp.add_argument("--retry-failed", action="store_true", help="run again the runs that failed before")
+    swp.add_argument("--quiet", action="store_true", help="no progress bar")
+    for command in (run, val, ren, wld, swp):
         command.add_argument("--include-path", type=Path, action="append", default=[], metavar="DIR",
                              help="a folder that tree includes may also resolve into (besides the tree's own "
                                   "folder and the shipped trees); repeatable")
@@ -96,6 +106,11 @@ def _command(args: argparse.Namespace) -> int:
             return world(shipped_or_given(args.scenario), args.preview, args.seed, include_path)
         if args.command == "render":
             return render(args.tree, args.format, args.out, include_path)
+        if args.command == "sweep":
+            from .sweep import sweep_command
+
+            return sweep_command(args.sweep, args.out, args.workers, args.scheduler, args.quiet, args.retry_failed,
+                                 include_path)
     except DelveError as err:
         print(err, file=sys.stderr)
         return 2
@@ -207,7 +222,9 @@ def _run_with_progress(mission) -> None:
 
 def validate(files: list[Path], include_path: tuple[Path, ...] = ()) -> int:
     """Check each file (a scenario when its top level has a scenario's keys, or near
-    misses of them; else a tree); print ``ok`` or the error. Exit 2 if any file is wrong."""
+    misses of them; else a tree); print ``ok`` or the error. A scenario's world is
+    built (as ``delve run`` does first) and its warnings and start errors printed as
+    ``delve world`` prints them. Exit 2 if any file is wrong; warnings alone exit 0."""
     from .document_kind import scenario_keys
     from .scenario import load_scenario
     from .tree_loader import check_tree
@@ -218,7 +235,11 @@ def validate(files: list[Path], include_path: tuple[Path, ...] = ()) -> int:
             doc = load_yaml(f)
             if isinstance(doc, YamlDict) and scenario_keys(doc):
                 scenario = load_scenario(f, include_path=include_path)
-                scenario.check_starts(scenario.build_world())
+                loaded = scenario.build_world()
+                if not _print_world(scenario.world_backend.describe(scenario, loaded), quiet=True):
+                    status = 2
+                    continue
+                scenario.check_starts(loaded)
             else:
                 check_tree(f, include_path=include_path)
             print(f"ok: {f}")

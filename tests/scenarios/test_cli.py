@@ -22,3 +22,25 @@ def test_render_writes_each_format(tmp_path):
         out = tmp_path / f"t.{fmt}"
         assert main(["render", str(tree), "--format", fmt, "--out", str(out)]) == 0
         assert out.stat().st_size > 0
+
+
+def test_validate_prints_the_world_warnings_and_start_errors(tmp_path, capsys):
+    from delve import TREES_DIR
+
+    from ..sim.mine_models import slab_and_wall, write_collada
+
+    write_collada(slab_and_wall(dead_end=True), tmp_path / "drift.dae", up="Y_UP")
+    text = ("name: drift\nseed: 1\nduration_s: 30\nworld:\n  mesh: drift.dae\n  up_axis: z\n  voxel_size_m: 0.2\n"
+            f"robots:\n  - name: anymal\n    platform: legged\n    tree: {TREES_DIR}/frontier_explorer.yaml\n"
+            "    start: {start}\n")
+    good, bad = tmp_path / "good.yaml", tmp_path / "bad.yaml"
+    good.write_text(text.format(start=[2.0, 0.0, 0.5]))
+    bad.write_text(text.format(start=[2.0, 2.1, 1.0]))  # in the wall
+    assert main(["validate", str(good)]) == 0
+    out, err = capsys.readouterr()
+    assert out == f"ok: {good}\n"
+    assert err.startswith(f"warning: {good}:5: the mesh encloses solids, not passages") and err.count("\n") == 1
+    assert main(["validate", str(bad), str(good)]) == 2
+    out, err = capsys.readouterr()
+    assert out == f"ok: {good}\n"
+    assert f"{bad}:12: robot 'anymal': start pose [2.0, 2.1, 1.0] is inside rock (nearest free floor: [" in err
