@@ -158,11 +158,9 @@ def default_start(world: World) -> np.ndarray:
     """
     v = world.voxel_size_m
     free = world.free
-    labels, n = ndimage.label(free, structure=np.ones((3, 3, 3), bool))
-    if n == 0:
+    labels, sizes = world.free_regions()          # cached: the checks before a run reuse them
+    if not sizes.any():
         raise ValueError(f"world {world.name!r} has no free space")
-    sizes = np.bincount(labels.ravel())
-    sizes[0] = 0
     main = labels == int(np.argmax(sizes))
     head = max(int(math.ceil(START_HEADROOM_M / v)), 1)
     floor = main.copy()
