@@ -287,6 +287,10 @@ class ArtifactSensors:
         self._normal = np.array([a.normal for a in self.artifacts]).reshape(-1, 3)
         self._cls = np.array([a.artifact_class for a in self.artifacts], dtype=object)
         self._tolerance_m = world.voxel_size_m
+        #: each body camera's axes (3, 3) in the body frame (rows: forward, left, up)
+        self._body_axes = [np.vstack(camera_axes(yaw, pitch))
+                           for yaw, pitch in zip(s.camera_yaw_deg, s.camera_pitch_deg)]
+        self._of_class = {cs: np.isin(self._cls, cs) for cs in (s.visual_classes, s.thermal_classes)}
         self._due: dict[str, float] = {}
         self._bluetooth = np.flatnonzero(np.isin(self._cls, s.bluetooth_classes))
         # the farthest a Bluetooth signal can be read (through air, three sigma of noise)
@@ -335,12 +339,11 @@ class ArtifactSensors:
         s = self.spec
         cams = []
         mount = trans + rot @ np.asarray(s.camera_mount_m, float)
-        for name, yaw, pitch in zip(s.camera_names, s.camera_yaw_deg, s.camera_pitch_deg):
+        for name, body_axes in zip(s.camera_names, self._body_axes):
             if self._frame_due(name, t_s, s.inference_rate_hz):
-                axes = rot @ np.vstack(camera_axes(yaw, pitch)).T
-                cams.append(_Camera(name, mount, axes.T, _tan_half(s.camera_horizontal_fov_deg,
-                                                                   s.camera_vertical_fov_deg),
-                                    s.camera_range_m, s.visual_classes))
+                cams.append(_Camera(name, mount, body_axes @ rot.T, _tan_half(
+                    s.camera_horizontal_fov_deg, s.camera_vertical_fov_deg),
+                    s.camera_range_m, s.visual_classes))
         if payload is None:
             return cams
         origin = payload.camera_position(np.vstack([np.c_[rot, trans], [0, 0, 0, 1]]))
@@ -366,9 +369,10 @@ class ArtifactSensors:
         line of sight from its optical centre to their centres through the true world."""
         if len(self._pos) == 0:
             return np.zeros(0, dtype=int)
-        near = np.flatnonzero(np.isin(self._cls, cam.classes)
+        near = np.flatnonzero(self._of_class[cam.classes]
                               & (np.abs(self._pos - cam.origin).max(axis=1) <= cam.range_m))
-        near = near[cam.in_view(self._pos[near])]
+        if len(near):
+            near = near[cam.in_view(self._pos[near])]
         if len(near) == 0:
             return near
         rel = self._pos[near] - cam.origin
@@ -439,33 +443,35 @@ class ArtifactSensors:
         return CameraDetection(float(t_s), cam.name, label, confidence, cam.origin.copy(), rays)
 
     # ---------------------------------------------------------------- signals
-    def rock_length_m(self, a: np.ndarray, b: np.ndarray) -> float:
-        """Metres of rock on the straight segment a-b in the true world (sampled every
-        half voxel)."""
-        length = float(np.linalg.norm(b - a))
-        n = max(int(math.ceil(length / (0.5 * self.world.voxel_size_m))), 1)
-        t = (np.arange(n) + 0.5) / n
-        pts = a + t[:, None] * (b - a)
-        return length * float(np.count_nonzero(~self.world.is_free(pts))) / n
+    def rock_length_m(self, sensor: np.ndarray, targets: np.ndarray) -> np.ndarray:
+        """Metres of rock (M,) on the straight segments from ``sensor`` to each target
+        (M, 3) in the true world, sampled every voxel (one ``is_free`` call for all)."""
+        targets = np.asarray(targets, float).reshape(-1, 3)
+        length = np.linalg.norm(targets - sensor, axis=1)
+        n = np.maximum(np.ceil(length / self.world.voxel_size_m).astype(int), 1)
+        seg = np.repeat(np.arange(len(targets)), n)
+        t = (np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n) + 0.5) / np.repeat(n, n)
+        pts = sensor + t[:, None] * (targets[seg] - sensor)
+        rock = np.bincount(seg, weights=~self.world.is_free(pts), minlength=len(targets))
+        return length * rock / n
 
-    def bluetooth_dbm(self, sensor: np.ndarray, i: int) -> float:
-        """Noise-free signal strength (dBm) of artifact ``i`` at ``sensor``."""
+    def bluetooth_dbm(self, sensor: np.ndarray, indices) -> np.ndarray:
+        """Noise-free signal strength (dBm) of the artifacts ``indices`` at ``sensor``."""
         s = self.spec
-        d = max(float(np.linalg.norm(self._pos[i] - sensor)), 1.0)   # the model holds from 1 m out
-        return (s.bluetooth_power_at_1m_dbm - 10.0 * s.path_loss_exponent * math.log10(d)
+        i = np.asarray(indices, dtype=int).reshape(-1)
+        d = np.maximum(np.linalg.norm(self._pos[i] - sensor, axis=1), 1.0)   # the model holds from 1 m
+        return (s.bluetooth_power_at_1m_dbm - 10.0 * s.path_loss_exponent * np.log10(d)
                 - s.rock_loss_db_per_m * self.rock_length_m(sensor, self._pos[i]))
 
     def _bluetooth_readings(self, t_s: float, sensor: np.ndarray) -> list[SignalReading]:
         s = self.spec
-        out = []
         near = self._bluetooth[np.linalg.norm(self._pos[self._bluetooth] - sensor, axis=1)
                                <= self._bluetooth_reach_m]
-        for i in near:
-            value = self.bluetooth_dbm(sensor, int(i)) + float(self.rng.normal(0.0, s.bluetooth_noise_db))
-            if value >= s.bluetooth_sensitivity_dbm:
-                out.append(SignalReading(float(t_s), "bluetooth", self.artifacts[int(i)].name,
-                                         sensor.copy(), value))
-        return out
+        if len(near) == 0:
+            return []
+        values = self.bluetooth_dbm(sensor, near) + self.rng.normal(0.0, s.bluetooth_noise_db, len(near))
+        return [SignalReading(float(t_s), "bluetooth", self.artifacts[int(i)].name, sensor.copy(), float(v))
+                for i, v in zip(near, values) if v >= s.bluetooth_sensitivity_dbm]
 
     def co2_ppm(self, sensor: np.ndarray, noise: bool = True) -> float:
         """CO2 concentration (ppm) at ``sensor``: the room's level within its radius of a

@@ -147,8 +147,9 @@ def test_payload_cameras_only_when_asked(world):
 
 def test_bluetooth_weaker_through_rock(world):
     s = _sensors(world, [{"class": "cell_phone", "position": [20.0, 8.0, 0.1]}])
-    air = s.bluetooth_dbm(np.array([12.0, 8.0, 0.5]), 0)
-    rock = s.bluetooth_dbm(np.array([20.0, 0.0, 0.5]), 0)
+    air = s.bluetooth_dbm(np.array([12.0, 8.0, 0.5]), [0])[0]
+    rock = s.bluetooth_dbm(np.array([20.0, 0.0, 0.5]), [0])[0]
+    assert s.rock_length_m(np.array([20.0, 0.0, 0.5]), s.artifacts[0].position)[0] == pytest.approx(4.0, abs=0.6)
     assert rock < air - 40.0
     readings = [r for r in _frames(s, _pose(12.0, 8.0), 30, period=1.0) if isinstance(r, SignalReading)]
     assert len(readings) == 30 and {r.identifier for r in readings} == {"cell_phone_1"}
