@@ -51,7 +51,7 @@ from .world import World
 VISUAL_CLASSES = ("survivor", "fire_extinguisher", "drill", "backpack", "vent", "helmet", "rope")
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class CameraDetection:
     """One detection by a camera's detector.
 
@@ -72,7 +72,7 @@ class CameraDetection:
     rays: np.ndarray
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class SignalReading:
     """One reading of the Bluetooth receiver or the CO2 sensor.
 

@@ -48,7 +48,7 @@ _UP = np.array([0.0, 0.0, 1.0])
 _SIDEWAYS = np.array([[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0]])
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Artifact:
     """One artifact (ground truth).
 
@@ -380,7 +380,11 @@ def place_artifacts(world: World, *, count: int, classes=ARTIFACT_CLASSES, seed:
     todo = list(order)
 
     def place(k: int, where: np.ndarray | None) -> None:
-        if placer.pick(cls_list[k], surfaces[k], where) is None:
+        art = placer.pick(cls_list[k], surfaces[k], where)
+        if art is None and surfaces[k] == "wall":              # walls used up: the floor then
+            surfaces[k] = "floor"
+            art = placer.pick(cls_list[k], "floor", None)
+        if art is None:
             fit = len(placer.placed) + placer.capacity()
             raise ValueError(f"world {world.name!r} can hold only {fit} of the {count} artifacts "
                              f"{spec.min_spacing_m:g} m apart (and {spec.min_start_distance_m:g} m "

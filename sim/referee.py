@@ -34,7 +34,7 @@ PRIZE_ROUND_REPORT_LIMIT = 45
 SCORING_RADIUS_M = 5.0
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Score:
     """The referee's answer to one report.
 
