@@ -16,17 +16,15 @@ from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
 from .navgraph import FACES, NavGraph, Voxels
-from .occupancy import FREE, UNKNOWN, Grid
-
-
-
+from .occupancy import FREE, OCCUPIED, UNKNOWN, Grid
 
 
 @dataclass(frozen=True)
 class FrontierCluster:
-    """A connected set of frontier voxels: their flat indices and world centroid."""
+    """A connected set of frontier voxels: their flat indices, their centres and the centroid."""
 
     voxels: np.ndarray
+    points: np.ndarray
     centroid: np.ndarray
 
     @property
@@ -70,6 +68,100 @@ def frontier_voxels(grid: Grid, among: np.ndarray | None = None, depth: int = FR
     return free.flat[is_frontier]
 
 
+#: Viewpoints tried per frontier voxel for a line of sight, spread from the nearest
+#: to the farthest of those whose elevation the sensor covers (bounds the work).
+SIGHT_TRIES = 6
+
+
+#: Goal and viewpoint candidates are thinned to one node per cell of this size (m).
+NODE_SPACING_M = 0.6
+
+
+def viewpoint_nodes(graph: NavGraph, distances: np.ndarray, spacing_m: float = NODE_SPACING_M) -> np.ndarray:
+    """The nodes reachable from the robot (finite ``distances``), thinned to the first of
+    each ``spacing_m`` cell (ascending, deterministic)."""
+    reachable = np.flatnonzero(np.isfinite(distances))
+    if len(reachable) == 0:
+        return reachable
+    cell = np.floor(graph.positions[reachable] / spacing_m).astype(np.int64)
+    cell -= cell.min(axis=0)
+    span = cell.max(axis=0) + 1
+    _, first = np.unique((cell[:, 0] * span[1] + cell[:, 1]) * span[2] + cell[:, 2], return_index=True)
+    return reachable[np.sort(first)]
+
+
+def in_view(sensor: np.ndarray, points: np.ndarray, view_up_deg: float, slack_m: float) -> np.ndarray:
+    """Whether each point is at most ``view_up_deg`` above the horizontal seen from its
+    ``sensor`` (rows pair up), give or take ``slack_m`` of height."""
+    diff = points - sensor
+    level = np.hypot(diff[:, 0], diff[:, 1])
+    return diff[:, 2] <= level * np.tan(np.radians(min(view_up_deg, 89.9))) + slack_m
+
+
+def clear_sight(grid: Grid, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Whether each segment ``a[i]``-``b[i]`` crosses no OCCUPIED voxel of the map and
+    stays inside it (sampled every half voxel, the end voxel excluded). Unknown voxels
+    do not block: the space between a viewpoint and a frontier is often unseen air."""
+    step = 0.5 * grid.voxel_size_m
+    length = np.linalg.norm(b - a, axis=1)
+    n = np.maximum(np.ceil(length / step).astype(np.int64), 1)
+    seg = np.repeat(np.arange(len(a)), n)
+    t = (np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n)) / n[seg]
+    pts = a[seg] + (b - a)[seg] * t[:, None]
+    idx = grid.to_index(pts)
+    inside = grid.in_bounds(idx)
+    occ = np.full(len(pts), OCCUPIED, dtype=np.int8)
+    occ[inside] = grid.occupancy[idx[inside, 0], idx[inside, 1], idx[inside, 2]]
+    blocked = np.zeros(len(a), dtype=bool)
+    np.logical_or.at(blocked, seg, occ == OCCUPIED)
+    return ~blocked
+
+
+def observable_frontiers(grid: Grid, voxels: np.ndarray, viewpoints: np.ndarray, *, view_up_deg: float,
+                         reach_m: float, tries: int = SIGHT_TRIES) -> np.ndarray:
+    """The frontier ``voxels`` (flat indices) that the sensor can observe from one of
+    the ``viewpoints`` (sensor positions the robot can reach), within ``reach_m``.
+
+    A frontier is the boundary of what the robot's sensor has seen, so it is a frontier
+    for that sensor only while some place the robot can stand would show it (CSIRO's
+    frontiers come from the sensor's own views and carry an observer position; here
+    the observer must exist). A LiDAR with a narrow vertical field of view, 30° on the
+    legged robot, sees a point ``dz`` above it only from at least ``dz / tan 15°``
+    away: the top of a 3 m drift from 8 m along it. Where no reachable viewpoint that
+    far has a clear line (the top of a dead end, of a short cross-cut, behind a bend),
+    the unknown air or rock above those voxels stays unknown however often the robot
+    visits them, and calling them frontiers sends it to look again and again and
+    leaves them on the map. A voxel is observable when, from at least one viewpoint,
+    it lies within ``view_up_deg`` above the sensor (with half a voxel of slack) and
+    the line to it crosses no known rock (:func:`clear_sight`); up to ``tries``
+    viewpoints per voxel are tried, spread from the nearest to the farthest.
+    """
+    if len(voxels) == 0 or len(viewpoints) == 0:
+        return voxels[:0]
+    pts = grid.to_world(np.stack(np.unravel_index(voxels, grid.shape), axis=1))
+    near = cKDTree(viewpoints).query_ball_point(pts, reach_m)
+    owner = np.repeat(np.arange(len(voxels)), [len(n) for n in near])
+    if len(owner) == 0:
+        return voxels[:0]
+    vp = np.concatenate([np.asarray(n, dtype=np.int64) for n in near])
+    keep = in_view(viewpoints[vp], pts[owner], view_up_deg, 0.5 * grid.voxel_size_m)
+    owner, vp = owner[keep], vp[keep]
+    dist = np.linalg.norm(viewpoints[vp] - pts[owner], axis=1)
+    order = np.lexsort((dist, owner))
+    owner, vp = owner[order], vp[order]
+    count = np.bincount(owner, minlength=len(voxels))
+    first = np.cumsum(count) - count
+    seen = np.zeros(len(voxels), dtype=bool)
+    for k in range(tries):
+        todo = np.flatnonzero(~seen & (count > k))
+        if len(todo) == 0:
+            break
+        # the k-th of ``tries`` picks, spread over each voxel's candidates by distance
+        pick = first[todo] + (k * count[todo]) // np.minimum(count[todo], tries)
+        seen[todo] = clear_sight(grid, viewpoints[vp[pick]], pts[todo])
+    return voxels[seen]
+
+
 def frontier_clusters(grid: Grid, voxels: np.ndarray, *, cluster_radius_m: float, min_cluster_voxels: int,
                       max_extent_m: float) -> list[FrontierCluster]:
     """Group frontier voxels into clusters of at most ``max_extent_m`` across.
@@ -103,8 +195,15 @@ def frontier_clusters(grid: Grid, voxels: np.ndarray, *, cluster_radius_m: float
     for c in range(labels.max() + 1):
         members = order[bounds[c] : bounds[c + 1]]
         if len(members) >= min_cluster_voxels:
-            clusters.append(FrontierCluster(voxels=voxels[members], centroid=pts[members].mean(axis=0)))
+            clusters.append(FrontierCluster(voxels=voxels[members], points=pts[members],
+                                            centroid=pts[members].mean(axis=0)))
     return clusters
+
+
+#: Cluster voxels sampled (evenly) to judge what a goal node sees of a cluster.
+VIEW_SAMPLES = 64
+#: Goal candidates, cheapest first, whose line of sight is checked before giving up on a cluster.
+SIGHT_CANDIDATES = 200
 
 
 def nearest_frontier(
@@ -116,42 +215,55 @@ def nearest_frontier(
     view_up_deg: float = 90.0,
     sensor_height_m: float = 0.0,
     offset_weight: float = 2.0,
-    node_spacing_m: float = 0.6,
+    node_spacing_m: float = NODE_SPACING_M,
+    view_fraction: float = 0.8,
+    grid: Grid | None = None,
 ) -> FrontierGoal | None:
     """The cluster whose goal node is cheapest: path length from the robot
     (``distances``) plus ``offset_weight`` times the straight distance to the cluster.
 
     A goal node must lie within ``max_goal_offset_m`` of the cluster's centroid and
-    see it: the centroid may be at most ``view_up_deg`` above the sensor
-    (``sensor_height_m`` above the node), so a ceiling frontier is approached from
-    where a LiDAR with a narrow vertical field of view can see it, not from below. A
-    far goal approaches a frontier the map cannot reach yet; a weight above 1 makes
-    the node nearest the frontier win over the robot's own. Candidate nodes are
-    thinned to one per ``node_spacing_m`` cell. None when no cluster has a goal.
+    see it: at least ``view_fraction`` of the cluster's voxels may be at most
+    ``view_up_deg`` above the sensor (``sensor_height_m`` above the node), and, with
+    ``grid``, the lines to them cross no known rock. Judging each voxel, not the
+    centroid, matters for a LiDAR with a narrow vertical field of view: a cluster
+    that spans a drift from the floor to the roof has its centroid low, and from a
+    node next to it the roof part is out of view, so the visit would leave most of it
+    a frontier. A far goal approaches a frontier the map cannot reach yet; a weight
+    above 1 makes the node nearest the frontier win over the robot's own. Candidate
+    nodes are thinned to one per ``node_spacing_m`` cell. None when no cluster has a goal.
     """
-    reachable = np.flatnonzero(np.isfinite(distances))
-    if len(reachable) == 0 or not clusters:
+    nodes = viewpoint_nodes(graph, distances, node_spacing_m)
+    if len(nodes) == 0 or not clusters:
         return None
-    cell = np.floor(graph.positions[reachable] / node_spacing_m).astype(np.int64)
-    cell -= cell.min(axis=0)
-    span = cell.max(axis=0) + 1
-    _, first = np.unique((cell[:, 0] * span[1] + cell[:, 1]) * span[2] + cell[:, 2], return_index=True)
-    nodes = reachable[np.sort(first)]
     centroids = np.array([c.centroid for c in clusters])
     near = cKDTree(graph.positions[nodes]).query_ball_point(centroids, max_goal_offset_m)
     owner = np.repeat(np.arange(len(clusters)), [len(n) for n in near])
     if len(owner) == 0:
         return None
     cand = nodes[np.concatenate([np.asarray(n, dtype=np.int64) for n in near])]
-    diff = centroids[owner] - graph.positions[cand]
-    offset = np.linalg.norm(diff, axis=1)
-    level = np.hypot(diff[:, 0], diff[:, 1])
-    seen = diff[:, 2] - sensor_height_m <= level * np.tan(np.radians(min(view_up_deg, 89.9))) + 0.5 * node_spacing_m
-    cost = np.where(seen, distances[cand] + offset_weight * offset, np.inf)
-    k = int(np.argmin(cost))
-    if not np.isfinite(cost[k]):
-        return None
-    node = int(cand[k])
-    return FrontierGoal(cluster=clusters[owner[k]], node=node, path_length_m=float(distances[node]),
-                        offset_m=float(offset[k]))
+    offset = np.linalg.norm(centroids[owner] - graph.positions[cand], axis=1)
+    samples = [_view_samples(c) for c in clusters]
+    sensor = graph.positions[cand] + np.array([0.0, 0.0, sensor_height_m])
+    frac = np.array([in_view(np.broadcast_to(s, samples[o].shape), samples[o], view_up_deg, 0.5 * node_spacing_m).mean()
+                     for s, o in zip(sensor, owner)]) if len(cand) else np.zeros(0)
+    cost = np.where(frac >= view_fraction, distances[cand] + offset_weight * offset, np.inf)
+    for k in np.argsort(cost, kind="stable")[:SIGHT_CANDIDATES]:
+        if not np.isfinite(cost[k]):
+            return None
+        pts = samples[owner[k]]
+        if grid is not None:
+            sight = in_view(np.broadcast_to(sensor[k], pts.shape), pts, view_up_deg, 0.5 * node_spacing_m)
+            sight &= clear_sight(grid, np.broadcast_to(sensor[k], pts.shape), pts)
+            if sight.mean() < view_fraction:
+                continue
+        node = int(cand[k])
+        return FrontierGoal(cluster=clusters[owner[k]], node=node, path_length_m=float(distances[node]),
+                            offset_m=float(offset[k]))
+    return None
 
+
+def _view_samples(cluster: FrontierCluster) -> np.ndarray:
+    """Up to :data:`VIEW_SAMPLES` of the cluster's voxel centres, evenly spread."""
+    pts = cluster.points
+    return pts[:: max(1, -(-len(pts) // VIEW_SAMPLES))]

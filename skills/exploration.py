@@ -7,7 +7,9 @@ import numpy as np
 from py_trees.common import Status
 from py_trees.ports import PortInformation
 
-from ..planners.frontier import FrontierCluster, FrontierGoal, frontier_clusters, frontier_voxels, nearest_frontier
+from ..planners.frontier import (FrontierCluster, FrontierGoal, frontier_clusters, frontier_voxels, nearest_frontier,
+                                 observable_frontiers, viewpoint_nodes)
+from ..planners.occupancy import Grid
 from ..planners.geometry import xyz
 from .base import Param, Skill
 from .navigation import Plan, navigator
@@ -106,10 +108,6 @@ float, 2.0, "how often the target cluster is re-checked", exclusive_minimum=0),
         grid = nav.grid()
         candidates = frontier_voxels(grid)
         candidates = candidates[~np.isin(candidates, self.blacklist)]
-        clusters = frontier_clusters(grid, candidates, cluster_radius_m=self.p["cluster_radius_m"],
-                                     min_cluster_voxels=self.p["min_cluster_voxels"],
-                                     max_extent_m=self.p["max_cluster_extent_m"])
-        self.write("frontiers_left", len(clusters))
         # First on the cached navigation graph; if that ends at the robot, on a fresh one.
         for fresh in (False, True):
             plan = nav.from_robot(force=fresh)
@@ -117,7 +115,9 @@ float, 2.0, "how often the target cluster is re-checked", exclusive_minimum=0),
                 self.feedback_message = "robot is not on its navigation graph"
                 self.event("explore_failed", reason=self.feedback_message)
                 return Status.FAILURE
-            goal = self._choose(plan, clusters)
+            clusters = self._clusters(grid, plan, candidates)
+            self.write("frontiers_left", len(clusters))
+            goal = self._choose(plan, clusters, grid)
             if goal is not None:
                 break
         else:
@@ -132,11 +132,22 @@ float, 2.0, "how often the target cluster is re-checked", exclusive_minimum=0),
                    clusters=len(clusters))
         return Status.RUNNING
 
-    def _choose(self, plan: Plan, clusters: list[FrontierCluster]) -> FrontierGoal | None:
+    def _clusters(self, grid: Grid, plan: Plan, candidates: np.ndarray) -> list[FrontierCluster]:
+        """Clusters of the ``candidates`` (frontier voxels) that the robot's sensor can
+        observe from a node it can reach (:func:`observable_frontiers`)."""
+        viewpoints = plan.graph.positions[viewpoint_nodes(plan.graph, plan.distances)]
+        seen = observable_frontiers(grid, candidates, viewpoints,
+                                    view_up_deg=self.robot.view_up_deg, reach_m=self.p["max_goal_offset_m"])
+        return frontier_clusters(grid, seen, cluster_radius_m=self.p["cluster_radius_m"],
+                                 min_cluster_voxels=self.p["min_cluster_voxels"],
+                                 max_extent_m=self.p["max_cluster_extent_m"])
+
+    def _choose(self, plan: Plan, clusters: list[FrontierCluster], grid: Grid) -> FrontierGoal | None:
         """The nearest frontier whose goal is not where the robot already stands."""
         while True:
             goal = nearest_frontier(plan.graph, plan.distances, clusters, max_goal_offset_m=self.p["max_goal_offset_m"],
-                                    view_up_deg=self.robot.view_up_deg)
+                                    view_up_deg=self.robot.view_up_deg, view_fraction=self.p["explored_fraction"],
+                                    grid=grid)
             if goal is None or goal.node != plan.source:
                 return goal
             if goal.offset_m <= self.p["observe_radius_m"]:

@@ -1,8 +1,11 @@
 import numpy as np
 
-from delve.planners.frontier import frontier_clusters, frontier_voxels, nearest_frontier
+from delve.planners.frontier import (frontier_clusters, frontier_voxels, nearest_frontier, observable_frontiers,
+                                    viewpoint_nodes)
 from delve.planners.navgraph import legged_graph
 from delve.planners.occupancy import FREE, OCCUPIED, UNKNOWN, Grid
+
+from .unseen_roof import drift_with_an_unseen_roof
 
 
 def t_junction() -> Grid:
@@ -44,3 +47,41 @@ def test_no_frontier_when_all_known():
     occ = np.full((20, 20, 10), OCCUPIED, dtype=np.int8)
     occ[5:15, 5:15, 2:8] = FREE
     assert len(frontier_voxels(Grid(occ, np.zeros(3), 0.2))) == 0
+
+
+def viewpoints_of(grid: Grid) -> tuple:
+    g = legged_graph(grid, body_height_m=0.5, radius_m=0.4, max_step_m=0.3, max_inclination_deg=35)
+    dist, _ = g.shortest_paths(g.nearest(np.array([1.0, 1.5, 0.9]), 1.0))
+    return g, dist, g.positions[viewpoint_nodes(g, dist)]
+
+
+def test_frontiers_that_a_narrow_lidar_sees_from_nowhere_reachable_are_not_frontiers():
+    # a short drift with a stub whose roof is unseen: from no node is the stub's top
+    # within 15 degrees above the sensor with a clear line (the stub's walls hide it)
+    short = drift_with_an_unseen_roof(6.0, 2.6, 3.8, stub=True)
+    front = frontier_voxels(short)
+    _, _, views = viewpoints_of(short)
+    assert len(front) > 50
+    assert len(observable_frontiers(short, front, views, view_up_deg=15.0, reach_m=12.0)) == 0
+    # a sensor that sees straight up does observe them
+    assert len(observable_frontiers(short, front, views, view_up_deg=90.0, reach_m=12.0)) == len(front)
+    # the unseen roof at the end of a long drift is seen from 6 m and more along it
+    long = drift_with_an_unseen_roof(20.0, 17.0, 20.0, stub=False)
+    front = frontier_voxels(long)
+    _, _, views = viewpoints_of(long)
+    seen = observable_frontiers(long, front, views, view_up_deg=15.0, reach_m=12.0)
+    assert len(front) > 50 and len(seen) >= 0.9 * len(front)
+
+
+def test_a_goal_sees_the_cluster_s_voxels_not_only_its_centroid():
+    # the roof at the end of a long drift: the goal is far enough back for a 15 degree
+    # view to reach the roof, not under it
+    grid = drift_with_an_unseen_roof(20.0, 17.0, 20.0, stub=False)
+    g, dist, _ = viewpoints_of(grid)
+    clusters = frontier_clusters(grid, frontier_voxels(grid), cluster_radius_m=0.8, min_cluster_voxels=5,
+                                 max_extent_m=20.0)
+    goal = nearest_frontier(g, dist, clusters, max_goal_offset_m=12.0, view_up_deg=15.0, grid=grid)
+    assert goal is not None
+    rise = goal.cluster.points[:, 2] - g.positions[goal.node][2]
+    level = np.hypot(*(goal.cluster.points[:, :2] - g.positions[goal.node][:2]).T)
+    assert np.mean(rise <= level * np.tan(np.radians(15.0)) + 0.3) >= 0.8
