@@ -73,6 +73,8 @@ def frontier_voxels(grid: Grid, among: np.ndarray | None = None, depth: int = FR
 SIGHT_TRIES = 6
 
 
+#: A goal node, and a viewpoint that counts, is at most this far from its frontier (m).
+MAX_GOAL_OFFSET_M = 12.0
 #: Goal and viewpoint candidates are thinned to one node per cell of this size (m).
 NODE_SPACING_M = 0.6
 

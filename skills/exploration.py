@@ -7,8 +7,8 @@ import numpy as np
 from py_trees.common import Status
 from py_trees.ports import PortInformation
 
-from ..planners.frontier import (FrontierCluster, FrontierGoal, frontier_clusters, frontier_voxels, nearest_frontier,
-                                 observable_frontiers, viewpoint_nodes)
+from ..planners.frontier import (MAX_GOAL_OFFSET_M, FrontierCluster, FrontierGoal, frontier_clusters, frontier_voxels,
+                                 nearest_frontier, observable_frontiers, viewpoint_nodes)
 from ..planners.occupancy import Grid
 from ..planners.geometry import xyz
 from .base import Param, Skill
@@ -36,7 +36,7 @@ class ExploreFrontiers(Skill):
         "cluster_radius_m": Param(float, 0.8, "frontier blocks (2×2×2 voxels) closer than this join", exclusive_minimum=0),
         "min_cluster_voxels": Param(int, 10, "smaller clusters are ignored", minimum=1),
         "max_cluster_extent_m": Param(float, 4.0, "larger clusters are split", exclusive_minimum=0),
-        "max_goal_offset_m": Param(float, 12.0, "a goal node is at most this far from its cluster", exclusive_minimum=0),
+        "max_goal_offset_m": Param(float, MAX_GOAL_OFFSET_M, "a goal node is at most this far from its cluster", exclusive_minimum=0),
         "observe_radius_m": Param(float, 3.0, "a frontier this near that stays one is unobservable",
                                   exclusive_minimum=0),
         "check_period_s": Param(

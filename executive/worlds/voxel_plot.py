@@ -10,8 +10,9 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from ...planners.frontier import frontier_voxels  # noqa: E402
+from ...planners.frontier import MAX_GOAL_OFFSET_M, frontier_voxels, observable_frontiers, viewpoint_nodes  # noqa: E402
 from ...planners.occupancy import Grid  # noqa: E402
+from ...skills.navigation import navigator  # noqa: E402
 
 if TYPE_CHECKING:
     from ..runner import Mission
@@ -21,8 +22,25 @@ def _top_down(mask: np.ndarray) -> np.ndarray:
     return mask.any(axis=2).T
 
 
+def frontiers_left(mission: "Mission", name: str) -> np.ndarray:
+    """World centres of the frontier voxels of robot ``name``'s map that its sensor could
+    still observe from a node it can reach (what its frontier explorer would still
+    go to: :func:`~delve.planners.frontier.observable_frontiers`); all frontier voxels
+    when the robot is off its navigation graph."""
+    robot = mission.robots[name]
+    m = robot.onboard_map
+    grid = Grid(m.occupancy, m.origin, m.voxel_size_m)
+    front = frontier_voxels(grid)
+    plan = navigator(mission.agents[name].ctx, robot).from_robot(force=True) if name in mission.agents else None
+    if plan is not None:
+        views = plan.graph.positions[viewpoint_nodes(plan.graph, plan.distances)]
+        front = observable_frontiers(grid, front, views, view_up_deg=robot.view_up_deg, reach_m=MAX_GOAL_OFFSET_M)
+    return grid.to_world(np.stack(np.unravel_index(front, m.shape), axis=1))
+
+
 def plot_voxel_map(mission: "Mission", truth_voxels: np.ndarray, path: Path) -> None:
-    """Top-down map: free space, what the team saw, walls, paths, frontiers, radio links."""
+    """Top-down map: free space, what the team saw, walls, paths, the frontiers left at
+    the end (:func:`frontiers_left`), radio links."""
     world = mission.world
     extent = (world.origin[0], world.origin[0] + world.free.shape[0] * world.voxel_size_m,
               world.origin[1], world.origin[1] + world.free.shape[1] * world.voxel_size_m)
@@ -43,11 +61,9 @@ def plot_voxel_map(mission: "Mission", truth_voxels: np.ndarray, path: Path) -> 
     for i, (name, robot) in enumerate(mission.robots.items()):
         trail = robot.traversed_path
         ax.plot(trail[:, 0], trail[:, 1], "-", lw=1.3, color=colours[i % len(colours)], label=f"{name} path")
-        m = robot.onboard_map
-        front = frontier_voxels(Grid(m.occupancy, m.origin, m.voxel_size_m))
-        if len(front):
-            pts = m.origin + (np.stack(np.unravel_index(front[::5], m.shape), axis=1) + 0.5) * m.voxel_size_m
-            ax.plot(pts[:, 0], pts[:, 1], ".", ms=1.5, color="red", label=f"{name} frontiers" if i == 0 else None)
+        pts = frontiers_left(mission, name)[::5]
+        if len(pts):
+            ax.plot(pts[:, 0], pts[:, 1], ".", ms=1.5, color="red", label="frontiers left" if i == 0 else None)
         pos = np.array([s.positions[name] for s in mission.state.samples])
         linked = np.array([s.linked[name] for s in mission.state.samples])
         ax.plot(pos[linked, 0], pos[linked, 1], "o", ms=3, color="green", label="radio link to base" if i == 0 else None)
