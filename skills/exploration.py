@@ -19,10 +19,12 @@ from .robot import PathStatus
 class ExploreFrontiers(Skill):
     """Nearest-frontier exploration: go to the nearest reachable frontier cluster, repeat.
 
-    Frontier voxels (known free next to unknown) of the onboard map are clustered; the
-    cluster whose goal node is nearest along the navigation graph is chosen and the
-    robot follows the path to it. The voxels of a cluster that is still a frontier
-    after a visit, or whose path is blocked, are blacklisted: never goals again.
+    Frontier voxels (known free next to unknown) of the onboard map that the robot's
+    LiDAR could observe from a node it can reach (within its view up, with a clear
+    line) are clustered; the cluster whose goal node, one that sees most of the
+    cluster, is nearest along the navigation graph is chosen and the robot follows the
+    path to it. The voxels of a cluster that is still a frontier after a visit, or
+    whose path is blocked, are blacklisted: never goals again.
 
     Writes: ``frontier_goal`` (x, y, z of the current goal), ``frontiers_left`` (clusters).
     Returns: RUNNING while exploring; SUCCESS when no reachable frontier is left;
