@@ -10,12 +10,15 @@ from __future__ import annotations
 import math
 from typing import Sequence
 
-#: Most voxels a world's grid may hold. The largest shipped world (demo's 400 m
-#: tunnel network at 0.2 m) has a box of 351 x 535 x 89 = 17 million voxels; a run
-#: keeps about one byte per voxel in the world, in each robot's onboard map and in
-#: the base station's map, so 100 million voxels is some 100 MB per grid, about
-#: 0.6 GB for a team of four.
-MAX_WORLD_VOXELS = 100_000_000
+#: Most voxels a world's grid may hold: a 300 x 500 m mine at 0.2 m up to 26 m tall
+#: (the largest shipped world, demo's 400 m tunnel network, has 16 million). A run
+#: keeps about 3 bytes per voxel for the world (free space, region labels, the space
+#: reachable from the start) and one in each robot's onboard map and in the base
+#: station's; building the world peaks at about 10 bytes a voxel (a generated
+#: mine) or 16 (a closed mesh file). So 500 million voxels: 1.5 GB for the world,
+#: 0.5 GB per robot, at most 8 GB while loading (docs/benchmarks.md, "Memory and
+#: scale").
+MAX_WORLD_VOXELS = 500_000_000
 #: Longest centreline a generator lays out (m): 50 times the largest shipped world
 #: (400 m); planning grows with it and the box with its square.
 MAX_TOTAL_LENGTH_M = 20_000.0
