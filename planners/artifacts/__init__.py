@@ -13,6 +13,6 @@ from .report import ARTIFACT_CLASSES, SOURCES, ArtifactReport
 from .signal_fusion import SignalCluster, SignalClusterer, ssid_class
 from .submission import choose
 
-__all__ = ["ARTIFACT_CLASSES", "SOURCES", "ArtifactReport", "ArtifactTrack", "ArtifactTracker", "CameraFusionParams",
-           "Candidate", "CandidateParams", "Candidates", "SignalCluster", "SignalClusterer", "SignalFusionParams",
-           "SignalParams", "SubmissionParams", "choose", "locate", "ssid_class"]
+__all__ = ["ARTIFACT_CLASSES", "SOURCES", "ArtifactReport", "ArtifactTrack", "ArtifactTracker",
+           "CameraFusionParams", "Candidate", "CandidateParams", "Candidates", "SignalCluster", "SignalClusterer",
+           "SignalFusionParams", "SignalParams", "SubmissionParams", "choose", "locate", "ssid_class"]

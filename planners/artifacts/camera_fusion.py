@@ -60,7 +60,8 @@ class ArtifactTracker:
         self._prior = float(np.log(self.params.prior / (1.0 - self.params.prior)))
         self.tracks: list[ArtifactTrack] = []
 
-    def add(self, t_s: float, artifact_class: str, confidence: float, position: np.ndarray) -> list[ArtifactReport]:
+    def add(self, t_s: float, artifact_class: str, confidence: float,
+            position: np.ndarray) -> list[ArtifactReport]:
         """Fuse one located detection (the detector's label and confidence, its (3,)
         world position). Returns the report this detection completes (at most one, and
         at most one per track ever), else []. Detections below ``min_confidence`` and
@@ -73,7 +74,8 @@ class ArtifactTracker:
         position = np.asarray(position, float).reshape(3)
         track = self._nearest(position)
         if track is None:
-            track = ArtifactTrack(len(self.tracks), position.copy(), np.full(len(ARTIFACT_CLASSES), self._prior))
+            prior = np.full(len(ARTIFACT_CLASSES), self._prior)
+            track = ArtifactTrack(len(self.tracks), position.copy(), prior)
             self.tracks.append(track)
         elif track.reported_class is not None:
             return []
@@ -88,8 +90,8 @@ class ArtifactTracker:
         if probability < self.params.report_threshold:
             return []
         track.reported_class = artifact_class
-        return [ArtifactReport(artifact_class, track.centre, probability, track.detections, float(t_s), "camera",
-                               self.robot)]
+        return [ArtifactReport(artifact_class, track.centre, probability, track.detections, float(t_s),
+                               "camera", self.robot)]
 
     def _nearest(self, position: np.ndarray) -> ArtifactTrack | None:
         """The track whose sphere holds ``position`` with the nearest centre (the older

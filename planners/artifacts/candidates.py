@@ -38,7 +38,8 @@ class Candidate:
     @property
     def position(self) -> np.ndarray:
         """Mean of the reports' positions weighted by their detections."""
-        return np.average([r.position for r in self.reports], axis=0, weights=[r.detections for r in self.reports])
+        weights = [r.detections for r in self.reports]
+        return np.average([r.position for r in self.reports], axis=0, weights=weights)
 
     @property
     def probability(self) -> float:

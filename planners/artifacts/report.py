@@ -42,7 +42,8 @@ class ArtifactReport:
 
     def __post_init__(self) -> None:
         if self.artifact_class not in ARTIFACT_CLASSES:
-            raise ValueError(f"unknown artifact class {self.artifact_class!r} (one of {', '.join(ARTIFACT_CLASSES)})")
+            raise ValueError(f"unknown artifact class {self.artifact_class!r} "
+                             f"(one of {', '.join(ARTIFACT_CLASSES)})")
         if self.source not in SOURCES:
             raise ValueError(f"unknown report source {self.source!r} (one of {', '.join(SOURCES)})")
         if not 0.0 <= self.probability <= 1.0:

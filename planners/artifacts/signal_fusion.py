@@ -7,9 +7,10 @@ Bluetooth readings are clustered by identifier (SSID); a CO2 reading joins the
 nearest CO2 cluster whose centre lies within ``cluster_distance_m``, else it starts a
 new one. A cluster's centre is the mean of the positions of its ``top_k`` strongest
 readings, weighted by their normalised values. A cluster is reported once, when it
-holds ``min_readings`` readings; later readings join it without a second report
-(CERBERUS re-reported a CO2 cluster each time its centre moved and flooded its
-supervisor with 30 reports in 5 minutes, section 4.2.2).
+holds ``min_readings`` readings and its strongest reading is followed by
+``after_peak_readings`` weaker ones (the robot has passed the source); later readings
+join it without a second report (CERBERUS re-reported a CO2 cluster each time its
+centre moved and flooded its supervisor with 30 reports in 5 minutes, section 4.2.2).
 
 A Bluetooth identifier's class comes from ``classify`` (identifier -> class or None);
 the default, :func:`ssid_class`, reads the simulator's names ("cell_phone_2" -> the
@@ -92,6 +93,8 @@ class SignalClusterer:
         cluster.positions.append(position)
         cluster.values.append(kind_params.normalise(value))
         if cluster.reported or len(cluster.values) < kind_params.min_readings:
+            return []
+        if len(cluster.values) - 1 - cluster.strongest(1)[0] < kind_params.after_peak_readings:
             return []
         cluster.reported = True
         strength = float(np.mean(np.asarray(cluster.values)[cluster.strongest(kind_params.top_k)]))

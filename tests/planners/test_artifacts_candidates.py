@@ -10,7 +10,8 @@ A = np.array([50.0, -10.0, 2.0])
 
 
 def _report(position, artifact_class="survivor", robot="anymal_1", detections=3, probability=0.97, t_s=0.0):
-    return ArtifactReport(artifact_class, np.asarray(position, float), probability, detections, t_s, "camera", robot)
+    return ArtifactReport(artifact_class, np.asarray(position, float), probability, detections, t_s, "camera",
+                          robot)
 
 
 def test_two_robots_reporting_one_artifact_make_one_candidate():

@@ -57,6 +57,18 @@ def test_no_report_before_enough_readings_above_threshold():
     assert s.add(100.0, "bluetooth", "cell_phone_3", near, -50.0) == []        # one report per cluster
 
 
+def test_a_rising_signal_is_reported_only_after_its_peak():
+    s = SignalClusterer()
+    after = SignalFusionParams().bluetooth.after_peak_readings
+    approach = _walk(0.0, 20.0, 21)                                   # up to beside the phone, 3 m away
+    assert all(s.add(float(i), "bluetooth", "cube_1", p, _rssi(p, PHONE)) == [] for i, p in enumerate(approach))
+    leave = _walk(21.0, 30.0, 10)
+    reports = [(i, r) for i, p in enumerate(leave)
+               for r in s.add(30.0 + i, "bluetooth", "cube_1", p, _rssi(p, PHONE))]
+    assert [i for i, _ in reports] == [after - 1]                     # the third reading past the peak
+    assert np.linalg.norm(reports[0][1].position - [20.0, 0.0, 1.0]) < 1.0
+
+
 def test_unknown_ssids_are_ignored_and_a_mapping_can_name_them():
     assert all(SignalClusterer().add(float(i), "bluetooth", "robot_wifi", PHONE, -50.0) == [] for i in range(10))
     s = SignalClusterer(classify=lambda ssid: "cube" if ssid.startswith("SubTCube") else None)
@@ -70,7 +82,7 @@ def test_co2_clusters_by_distance():
     rooms = [np.array([0.0, 0.0, 1.0]), np.array([30.0, 0.0, 1.0])]
     for i in range(12):
         for room in rooms:
-            reports += s.add(float(i), "co2", None, room + [0.2 * i, 0.0, 0.0], 3000.0 + 10.0 * i)
+            reports += s.add(float(i), "co2", None, room + [0.2 * i, 0.0, 0.0], 3000.0 - 10.0 * abs(i - 5))
     assert len(s.clusters) == 2
     assert [r.artifact_class for r in reports] == ["gas", "gas"]
     for room, r in zip(rooms, reports):
