@@ -10,19 +10,33 @@ PLAN_FIELDS = ("cycle", "final", "robots", "locations", "frontiers", "explorers"
 
 
 def cops_figures(events: list[dict[str, Any]]) -> dict[str, Any]:
-    """Cycles, plans that passed the validator, why planning failed, each plan (with
-    its work: simplex iterations), and the safety stops (wall clock) that fired while
-    planning: with one, the run may not be reproducible (``reproducible`` is false)."""
+    """Cycles, plans that passed the validator, why planning failed, the moves robots
+    could not make, each plan (with its work: simplex iterations), and the safety
+    stops (wall clock) that fired while planning: with one, the run may not be
+    reproducible (``reproducible`` is false)."""
     plans = [e for e in events if e["event"] == "cops_plan"]
     stops = sum(e["count"] for e in events if e["event"] == "cops_safety_stop")
     return {
         "cycles": len(plans),
         "plans_valid": sum(1 for e in plans if e.get("valid")),
         "no_plan": [e["reason"] for e in events if e["event"] in ("cops_no_plan", "cops_invalid_plan")],
+        "transitions_failed": transition_failures(events),
         "safety_stops": stops,
         "reproducible": stops == 0,
         "plans": [{k: e.get(k) for k in PLAN_FIELDS} for e in plans],
     }
+
+
+def transition_failures(events: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """Every move a robot could not make (``cops_transition_failed``): robot, time,
+    from, to, reason."""
+    return [{"robot": e["robot"], "t": e["t"], "from": e["from"], "to": e["to"], "reason": e["reason"]}
+            for e in events if e["event"] == "cops_transition_failed"]
+
+
+def home_by_endurance(events: list[dict[str, Any]]) -> list[str]:
+    """Robots that left the plan for home because their endurance barely covered the way."""
+    return sorted({e["agent"] for e in events if e["event"] == "cops_home_by_endurance"})
 
 
 def declared_lost(events: list[dict[str, Any]]) -> list[str]:

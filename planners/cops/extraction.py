@@ -30,13 +30,15 @@
   clipping the corner of a cell, a second passage through a cell) are not lost:
   the locations that one connected fragment of them touches are joined pairwise.
   An edge's length is the distance between the positions.
-* **Open areas** (:mod:`delve.planners.cops.regions`): cells side by side whose
-  locations' free space touches through open space (a horizontal disc of
+* **Open areas** (:mod:`delve.planners.cops.regions`): explored cells side by side
+  whose locations' free space touches through open space (a horizontal disc of
   ``open_radius_m`` fits there: wider than a tunnel) are merged into one location,
   a region of at most ``max_region_m`` across, named after its member nearest cell
   (0, 0, 0); ``keep`` cells are never merged, ``prior`` merges (a ``merged`` map)
-  always hold. A region's position is its member's position nearest the mean of
-  its members' positions; it is explored when a member is; its edges are its
+  always hold. Only explored cells are merged, so the cells of an open area that
+  nobody has explored yet stay locations of their own, the frontiers' targets, and
+  join the region once explored. A region's position is its member's position nearest the mean of
+  its members' positions; it is explored when every member is; its edges are its
   members' edges to other locations, with lengths between positions. The
   topology's ``merged`` maps every member to its region. ``open_radius_m=None``
   merges nothing (the lattice's cells alone).
@@ -155,12 +157,13 @@ def extract_topology(
     if open_radius_m is not None:
         opened = open_faces(labels, partition, open_space(mask | passable_mask, grid.voxel_size_m, open_radius_m))
         loc = location_of[opened]
-        merged = group_cells(names, lattice, loc[np.all(loc >= 0, axis=1)], cell_m=cell_m,
+        loc = loc[np.all(loc >= 0, axis=1)]
+        merged = group_cells(names, lattice, loc[np.all(explored[loc], axis=1)], cell_m=cell_m,
                              max_region_m=max_region_m, prior=prior, keep=keep)
     region = np.array([merged.get(n, n) for n in names])
     names, index = np.unique(region, return_inverse=True)
     positions = _region_positions(positions, index, len(names))
-    explored = np.bincount(index, weights=explored, minlength=len(names)) > 0
+    explored = np.bincount(index, weights=~explored, minlength=len(names)) == 0
     mobility = _unique_pairs(index[mobility])
     mobility = mobility[mobility[:, 0] != mobility[:, 1]]
     topo.merged = merged

@@ -42,9 +42,10 @@ from scipy import ndimage
 #: or a crossing of tunnels (the generated mines' tunnels are 3 to 5 m wide, a
 #: crossing of two holds a disc of 3.5 m): an open area, as wide as an 8 m cell.
 DEFAULT_OPEN_RADIUS_M = 4.0
-#: A region spans at most this much (m) along any axis (five 8 m cells: a 30 m yard
-#: fits in one region wherever the lattice cuts it).
-DEFAULT_MAX_REGION_M = 40.0
+#: A region spans at most this much (m) along any axis (eight 8 m cells: a 56 m yard
+#: fits in one region wherever the lattice cuts it), so that a long wide drift or
+#: cavern is a chain of regions, not one location.
+DEFAULT_MAX_REGION_M = 64.0
 
 #: 8-neighbours within a horizontal layer.
 _IN_LAYER = np.zeros((3, 3, 3), dtype=bool)
@@ -110,6 +111,35 @@ def open_faces(labels: np.ndarray, partition: list[np.ndarray], open_mask: np.nd
     return np.unique(pairs, axis=0).reshape(-1, 2)
 
 
+class _Regions:
+    """Union-find of cells (networkx's) with each region's lattice box."""
+
+    def __init__(self, where: Mapping[str, tuple[int, int, int]]):
+        self.where, self.sets = where, UnionFind()
+        self.box: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+
+    def root(self, name: str) -> str:
+        if name not in self.box:
+            cell = np.array(self.where.get(name) or cell_of_name(name) or (0, 0, 0))
+            self.box[name] = (cell, cell)
+        return self.sets[name]
+
+    def joined_box(self, u: str, v: str) -> tuple[np.ndarray, np.ndarray]:
+        (a, b), (c, d) = self.box[self.root(u)], self.box[self.root(v)]
+        return np.minimum(a, c), np.maximum(b, d)
+
+    def union(self, u: str, v: str) -> None:
+        if self.root(u) != self.root(v):
+            joined = self.joined_box(u, v)
+            self.sets.union(u, v)
+            self.box[self.root(u)] = joined
+
+    def merged(self) -> dict[str, str]:
+        """Member -> region name, for every member that is not its region's name."""
+        out = {m: region_name(group) for group in self.sets.to_sets() for m in group}
+        return {m: n for m, n in sorted(out.items()) if m != n}
+
+
 def group_cells(names: list[str], cells: np.ndarray, open_pairs: np.ndarray, *, cell_m: float,
                 max_region_m: float = DEFAULT_MAX_REGION_M, prior: Mapping[str, str] | None = None,
                 keep: Iterable[str] = ()) -> dict[str, str]:
@@ -123,50 +153,14 @@ def group_cells(names: list[str], cells: np.ndarray, open_pairs: np.ndarray, *, 
     cells that may no longer be locations) always holds. Cells in ``keep`` are never
     merged."""
     kept = set(keep)
-    where = {n: tuple(int(v) for v in c) for n, c in zip(names, np.asarray(cells).reshape(-1, 3).tolist())}
-    regions = UnionFind()
-    box: dict[str, tuple[np.ndarray, np.ndarray]] = {}
-
-    def span(root: str) -> tuple[np.ndarray, np.ndarray]:
-        return box[root]
-
-    def add(name: str) -> None:
-        if name not in box:
-            c = where.get(name) or cell_of_name(name)
-            p = np.array(c if c is not None else (0, 0, 0))
-            regions[name]
-            box[name] = (p, p)
-
-    def union(u: str, v: str) -> None:
-        ru, rv = regions[u], regions[v]
-        if ru == rv:
-            return
-        lo = np.minimum(span(ru)[0], span(rv)[0])
-        hi = np.maximum(span(ru)[1], span(rv)[1])
-        regions.union(ru, rv)
-        box[regions[ru]] = (lo, hi)
-
+    regions = _Regions({n: tuple(int(v) for v in c) for n, c in zip(names, np.asarray(cells).reshape(-1, 3).tolist())})
     for member, name in sorted((prior or {}).items()):
-        if member in kept or name in kept:
-            continue
-        add(member), add(name)
-        union(member, name)
+        if not {member, name} & kept:
+            regions.union(member, name)
     limit = int(np.floor(max_region_m / cell_m + 1e-9))
-    pairs = sorted({tuple(sorted((names[a], names[b]))) for a, b in np.asarray(open_pairs).reshape(-1, 2).tolist()})
-    for u, v in pairs:
-        if u in kept or v in kept:
-            continue
-        add(u), add(v)
-        ru, rv = regions[u], regions[v]
-        if ru == rv:
-            continue
-        lo = np.minimum(span(ru)[0], span(rv)[0])
-        hi = np.maximum(span(ru)[1], span(rv)[1])
-        if np.all(hi - lo + 1 <= limit):
-            union(u, v)
-    merged: dict[str, str] = {}
-    for group in regions.to_sets():
-        if len(group) > 1:
-            head = region_name(group)
-            merged.update({m: head for m in group if m != head})
-    return dict(sorted(merged.items()))
+    pairs = {tuple(sorted((names[a], names[b]))) for a, b in np.asarray(open_pairs).reshape(-1, 2).tolist()}
+    for u, v in sorted(pairs):
+        lo, hi = regions.joined_box(u, v)
+        if not {u, v} & kept and np.all(hi - lo + 1 <= limit):
+            regions.union(u, v)
+    return regions.merged()

@@ -106,7 +106,8 @@ class Topology:
                 pos = self.locations.pop(name)
                 self.locations.setdefault(rename(name), pos)
         self.explored = {rename(s) for s in self.explored}
-        self.unreachable = {rename(s) for s in self.unreachable}
+        # a cell some robot could not get to is no reason to think its region unreachable
+        self.unreachable = {s for s in self.unreachable if rename(s) == s}
         mobility: dict[tuple[str, str], float] = {}
         for (u, v), length in sorted(self.mobility.items()):
             a, b = rename(u), rename(v)

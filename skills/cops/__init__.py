@@ -17,6 +17,8 @@ Behaviours, in the paper's words, by module:
 * :mod:`.motion`: ``TransitionAction`` and ``ActionTimer``, ``ExplorationAction``
   (Algorithm 1), ``ExplorationTimer``, ``TransitToReturnNode``.
 * :mod:`.conditions`: ``Explore?`` (``IsExploring``) and ``FinishedPlan?``.
+* :mod:`.endurance`: ``LeavePlan``, ``TransitToBase`` and ``GreetBase``, a
+  robot's way home by endurance (after the onboard ``EnduranceLow``).
 
 :mod:`.state` holds the state and the message ids, :mod:`.base` the behaviours'
 common base, :mod:`.voxel_view` the network a robot's voxel map reveals.
@@ -26,6 +28,7 @@ from __future__ import annotations
 from .base import STATE_KEY, CopsSkill, network_view
 from .communication import CommunicationAction, InformationStorage
 from .conditions import FinishedPlan, IsExploring
+from .endurance import GreetBase, LeavePlan, TransitToBase
 from .leader import IsLeader, MissionComplete, ReturnWithoutPlan, SolveCOPS, WaitToReceivePlan
 from .motion import (ActionTimer, ExplorationAction, ExplorationTimer, TransitionAction, TransitToReturnNode,
                      ordered_choices)
@@ -33,8 +36,8 @@ from .state import KIND, PARTS, CopsState, Knowledge, collect_own_map, final_pla
 
 __all__ = [
     "KIND", "PARTS", "STATE_KEY", "ActionTimer", "CommunicationAction", "CopsSkill", "CopsState",
-    "ExplorationAction", "ExplorationTimer", "FinishedPlan", "InformationStorage", "IsExploring", "IsLeader",
-    "Knowledge", "MissionComplete", "ReturnWithoutPlan", "SolveCOPS", "TransitToReturnNode",
-    "TransitionAction", "WaitToReceivePlan", "collect_own_map", "final_plan_id", "message_id", "network_view",
-    "ordered_choices",
+    "ExplorationAction", "ExplorationTimer", "FinishedPlan", "GreetBase", "InformationStorage", "IsExploring",
+    "IsLeader", "Knowledge", "LeavePlan", "MissionComplete", "ReturnWithoutPlan", "SolveCOPS", "TransitToBase",
+    "TransitToReturnNode", "TransitionAction", "WaitToReceivePlan", "collect_own_map", "final_plan_id",
+    "message_id", "network_view", "ordered_choices",
 ]

@@ -6,6 +6,7 @@ from typing import Any
 
 from py_trees.common import Status
 
+from ...planners.cops.topology import Topology
 from ..base import AgentContext, Param, ParamNamedPort, Skill
 from ..robot import NetworkView, PathStatus
 from .state import KIND, CopsState, collect_own_map
@@ -73,9 +74,14 @@ class CopsSkill(Skill):
         """Drive towards location ``there`` through the NetworkView: None once there
         (in its region; with ``arrive``, at the end of its route to the position, or as
         near the position as the robot can get inside the region), RUNNING on the way,
-        FAILURE when it cannot get there (no route, or blocked). A route that ends short of ``there`` (a voxel map's
-        graph reaches further as the robot walks) is asked for again where it ends."""
+        FAILURE when it cannot get there (no route, or blocked; logged
+        ``cops_transition_failed`` with the robot, ``from`` (its location), ``to`` and
+        the ``reason``). A route that ends short of ``there`` (a voxel map's graph
+        reaches further as the robot walks) is asked for again where it ends. A name
+        the view knows under another (a lattice cell merged into a region, see
+        :func:`view_name`) is driven to under the view's name."""
         view, robot = network_view(self.ctx), self.robot
+        there = view_name(view, there, self.state.knowledge.topology)
         inside = view.location() == there
         on_own_route = self._driving == there and getattr(self, "_command_id", None) == robot.command_id
         if inside and (not arrive or not (on_own_route and robot.path_status == PathStatus.FOLLOWING)
@@ -88,11 +94,34 @@ class CopsSkill(Skill):
                 self._driving, self._settled = None, there
                 return None
             if route is None:
-                self.feedback_message = f"no route to {there}"
-                return Status.FAILURE
+                return self._failed(view, there, f"no route to {there}")
             self.follow(route)
             self._driving = there
         if robot.path_status == PathStatus.BLOCKED:
-            self.feedback_message = f"blocked on the way to {there}"
-            return Status.FAILURE
+            reason = f"blocked on the way to {there}"
+            return self._failed(view, there, f"{reason}: {robot.blocked_reason}" if robot.blocked_reason else reason)
         return Status.RUNNING
+
+    def _failed(self, view: NetworkView, there: str, reason: str) -> Status:
+        """FAILURE of a drive, with its reason as feedback and as an event."""
+        st = self.state
+        self.feedback_message = reason
+        self.event("cops_transition_failed", robot=self.ctx.name, cycle=st.cycle, part=st.part, step=st.step,
+                   reason=reason, **{"from": view.location(), "to": there})
+        return Status.FAILURE
+
+
+def view_name(view: NetworkView, name: str, topology: Topology) -> str:
+    """The name under which ``view`` knows the location ``name`` of an agent's
+    ``topology``: a view that merges cells into regions (``resolve``) may know it
+    under its region's name or, when the topology merged more than the view's map,
+    under the name of another member; else ``name`` itself."""
+    resolve = getattr(view, "resolve", None)
+    if resolve is None:
+        return name
+    found = resolve(name)
+    for member in topology.members(name) if found is None else ():
+        found = resolve(member)
+        if found is not None:
+            break
+    return found if found is not None else name

@@ -148,7 +148,7 @@ class CommunicationAction(CopsSkill):
             if waiting:
                 for c in waiting:
                     other = self._partner(c)
-                    if other in kn.lost:
+                    if other in kn.retired:
                         continue
                     silent_s = now - max(self._since, kn.heard.get(other, -math.inf))
                     if silent_s > st.lost_timeout_s + self._allow(other):
@@ -185,7 +185,7 @@ class CommunicationAction(CopsSkill):
         kn = st.knowledge
         mid = message_id(st.cycle, st.part, c)
         other = self._partner(c)
-        return other in kn.lost or kn.finished.get(other) == st.cycle or (
+        return other in kn.retired or kn.finished.get(other) == st.cycle or (
             mid in kn.acked if c.sender == self.ctx.name else mid in kn.received)
 
     def _send(self, c: Communication, st: CopsState, now: float) -> None:

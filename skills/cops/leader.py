@@ -34,15 +34,17 @@ class SolveCOPS(CopsSkill):
     """COPS: plan the next cycle at the leader (the base station).
 
     From everything the leader knows it builds the network N (explored locations),
-    places the team (robots not declared lost, where the last plan left them) and
-    plans pre-exploration, exploration and post-exploration (``plan_cycle``). Robots
-    whose earlier information never reached the base are added to the
-    post-exploration sources. With no frontier left, the plan is the recall: m
-    reaches every robot and brings it to the base, where those sources hand over
-    what the base lacks. Robots coming back by the standing order of m are planned
-    static at the base; so are, in a recall, robots that order will have sent home
-    before the recall's m reaches them (logged ``cops_replan_returning``). Every
-    plan is checked with the plan validator before it is used.
+    places the team (robots not declared lost nor gone home by endurance, where the
+    last plan left them) and plans pre-exploration, exploration and
+    post-exploration (``plan_cycle``). Robots whose earlier information never
+    reached the base are added to the post-exploration sources. With no frontier
+    left, the plan is the recall: m reaches every robot and brings it to the base,
+    where those sources hand over what the base lacks; with no robot left, the
+    (empty) recall is the last plan. Robots coming back by the standing order of m
+    are planned static at the base; so are, in a recall, robots that order will
+    have sent home before the recall's m reaches them (logged
+    ``cops_replan_returning``). Every plan is checked with the plan validator
+    before it is used.
 
     Solves are bounded by work limits (``SolverOptions``), so the plans do not
     depend on the machine's load; ``time_limit_s`` is only a safety stop, and each
@@ -85,7 +87,7 @@ class SolveCOPS(CopsSkill):
                 returning = sorted(set(returning) | gone)
                 net, cyc = self._plan(st, {r: base_loc if r in gone else s for r, s in positions.items()}, returning)
             positions, frontiers, owed = net.positions(), net.frontiers, cyc.meta["owed"]
-            if frontiers and not cyc.exploration and not owed:
+            if frontiers and not cyc.exploration and not owed and set(positions) - {self.ctx.name}:
                 raise PlanningError(f"{len(frontiers)} frontiers left but no robot that m can reach is "
                                     f"sent to one (robots out of radio reach of the base and of each other)")
             cyc.meta["explored"] = sorted(kn.topology.explored)
@@ -100,7 +102,8 @@ class SolveCOPS(CopsSkill):
         if problems:
             self.event("cops_invalid_plan", cycle=st.cycle + 1, reason=str(problems[0]))
             return Status.FAILURE
-        final = not frontiers and not owed and not cyc.meta.get("stranded")
+        nobody = not set(positions) - {self.ctx.name}  # every robot lost or home by endurance
+        final = (not frontiers or nobody) and not owed and not cyc.meta.get("stranded")
         st.cycle += 1
         for r in cyc.exploration:
             st.explored_in[r] = st.cycle
@@ -123,12 +126,13 @@ class SolveCOPS(CopsSkill):
         """Where the last plan left each robot not declared lost, and the robots that
         go back to the base by the standing order of m (the last plan did not reach
         them, or no new plan can)."""
-        alive = {r: s for r, s in team.items() if r not in st.knowledge.lost}
+        topo = st.knowledge.topology
+        alive = {r: topo.resolve(s) for r, s in team.items() if r not in st.knowledge.retired}
         if st.plan is None:
             return alive, []
         last = st.plan.post.final_positions()
         reached = st.plan.pre.master_receivers() | st.plan.post.master_receivers()
-        pos = {r: last.get(r, s) if r in reached else st.base_location for r, s in alive.items()}
+        pos = {r: topo.resolve(last.get(r, s)) if r in reached else st.base_location for r, s in alive.items()}
         unreachable = _unreachable(st.knowledge.topology, st.base_location, pos)
         return {r: st.base_location if r in unreachable else s for r, s in pos.items()}, sorted(unreachable)
 
@@ -143,7 +147,7 @@ class SolveCOPS(CopsSkill):
         positions = net.positions()
         opts = SolverOptions(time_limit_s=self.p["time_limit_s"], meter=self._meter)
         owed = {r for r in positions if st.explored_in.get(r, -1) > kn.freshness.get(r, -1)}
-        plan = self._cycle if net.frontiers else self._recall
+        plan = self._cycle if net.frontiers and set(positions) - {self.ctx.name} else self._recall
         static = {self.ctx.name, *returning}
         if net.frontiers and not set(positions) - static:
             static = {self.ctx.name}
@@ -341,7 +345,8 @@ class MissionComplete(CopsSkill):
             return self._home(st, now)
         team = self.ctx.services["team"]
         kn = st.knowledge
-        away = [r for r in sorted(team) if final_plan_id(st.cycle, r) not in kn.acked]
+        away = [r for r in sorted(team) if final_plan_id(st.cycle, r) not in kn.acked
+                and r not in kn.home_by_endurance]
         if away and now - st.planned_s > st.recall_after_s + st.lost_timeout_s:
             for r in away:
                 kn.declared[r] = now

@@ -136,6 +136,7 @@ class ExplorationAction(CopsSkill):
     def update(self) -> Status:
         st = self.state
         topo = st.knowledge.topology
+        self._rename(topo)
         if self._moving is not None:
             moving = self.drive_to(self._moving)
             if moving == Status.RUNNING:
@@ -148,7 +149,7 @@ class ExplorationAction(CopsSkill):
             self._prev, self._at, self._moving = self._at, self._moving, None
             self._visited.add(self._at)
         if self._prev is None:
-            explored = set(st.plan.meta.get("explored", ())) | self._visited | topo.unreachable
+            explored = {topo.resolve(s) for s in st.plan.meta.get("explored", ())} | self._visited | topo.unreachable
             cands = [s for s in topo.neighbours(self._at) if s not in explored]
         else:
             cands = [s for s in topo.neighbours(self._at)
@@ -163,6 +164,14 @@ class ExplorationAction(CopsSkill):
         self._i_before, self._i, self._moving = self._i, i, choice
         self.feedback_message = f"to {choice} (i={self._i})"
         return Status.RUNNING
+
+    def _rename(self, topo: Topology) -> None:
+        """Follow the renames of locations merged into regions since the last tick."""
+        if topo.merged:
+            self._at = topo.resolve(self._at)
+            self._prev = topo.resolve(self._prev) if self._prev is not None else None
+            self._moving = topo.resolve(self._moving) if self._moving is not None else None
+            self._visited = {topo.resolve(s) for s in self._visited}
 
     def terminate(self, new_status: Status) -> None:
         self.stop_own_motion()

@@ -34,7 +34,9 @@ class Knowledge:
     holds ("r1/4" -> (flat indices, values)), carried like the rest of the
     information until they reach the base station's map.
     ``finished[r]``: the final plan's cycle, for a robot that got it at the base with
-    its part done (its communications in that plan count as done)."""
+    its part done (its communications in that plan count as done).
+    ``home_by_endurance[r]``: when robot r left the plan for home because its
+    endurance barely covered the way (it takes part in no plan any more)."""
 
     topology: Topology = field(default_factory=Topology)
     freshness: dict[str, int] = field(default_factory=dict)
@@ -45,6 +47,13 @@ class Knowledge:
     pending_plan: dict[str, Any] | None = None
     map_chunks: dict[str, tuple[Any, Any]] = field(default_factory=dict)
     finished: dict[str, int] = field(default_factory=dict)
+    home_by_endurance: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def retired(self) -> set[str]:
+        """Robots that take part in no plan any more: declared lost, or gone home by
+        endurance."""
+        return self.lost | self.home_by_endurance.keys()
 
     @property
     def lost(self) -> set[str]:
@@ -53,7 +62,7 @@ class Knowledge:
     def payload(self) -> dict[str, Any]:
         return {"topology": self.topology.to_dict(), "freshness": dict(self.freshness),
                 "declared": dict(self.declared), "heard": dict(self.heard), "map": dict(self.map_chunks),
-                "finished": dict(self.finished)}
+                "finished": dict(self.finished), "home_by_endurance": dict(self.home_by_endurance)}
 
     def collect_map(self, robot: str, onboard_map: Any) -> None:
         """Add what ``robot``'s onboard map gained since the last call as a chunk."""
@@ -66,7 +75,8 @@ class Knowledge:
             self.map_chunks.setdefault(key, chunk)
         self.topology.merge(Topology.from_dict(payload["topology"]))
         for mine, theirs in ((self.freshness, payload["freshness"]), (self.declared, payload["declared"]),
-                             (self.heard, payload["heard"]), (self.finished, payload.get("finished", {}))):
+                             (self.heard, payload["heard"]), (self.finished, payload.get("finished", {})),
+                (self.home_by_endurance, payload.get("home_by_endurance", {}))):
             for r, v in theirs.items():
                 mine[r] = max(mine.get(r, -math.inf), v)
 

@@ -15,6 +15,13 @@ above spans. Routes to a location are shortest paths on the navigation graph; wh
 the graph does not reach a location yet, the route leads to the reachable node
 nearest it, and the robot asks again there, with more of the floor mapped. The cells
 the robot has passed through (its traversed path) count as explored.
+
+Cells side by side in an open area are merged into one location
+(:mod:`delve.planners.cops.regions`); the view keeps the merges it has made (a
+region only grows) and never merges the lattice's cell (0, 0, 0), the base's (the
+backend centres it on the team's start), so the base location keeps its name. A
+name the robot's map knows as a member of a region stands for that region
+(:meth:`VoxelNetworkView.resolve`).
 """
 from __future__ import annotations
 
@@ -30,7 +37,9 @@ from ...planners.cops.extraction import (
     cell_name,
     extract_topology,
     lattice_cells,
+    line_of_sight,
 )
+from ...planners.cops.regions import DEFAULT_MAX_REGION_M, DEFAULT_OPEN_RADIUS_M, cell_of_name
 from ...planners.cops.topology import Topology
 from ...planners.navgraph import NavGraph
 from ...planners.occupancy import FREE, Grid
@@ -71,7 +80,8 @@ class VoxelNetworkView:
 
     def __init__(self, robot: Robot, *, cell_m: float = DEFAULT_CELL_M,
                  comm_range_m: float = DEFAULT_COMM_RANGE_M, min_free_voxels: int = DEFAULT_MIN_FREE_VOXELS,
-                 navigator: Navigator | None = None, lattice_origin: np.ndarray | None = None):
+                 navigator: Navigator | None = None, lattice_origin: np.ndarray | None = None,
+                 open_radius_m: float | None = DEFAULT_OPEN_RADIUS_M, max_region_m: float = DEFAULT_MAX_REGION_M):
         if not (isinstance(cell_m, (int, float)) and math.isfinite(cell_m) and cell_m > 0):
             raise ValueError(f"cell_m must be a positive finite number, got {cell_m!r}")
         self.robot = robot
@@ -79,6 +89,9 @@ class VoxelNetworkView:
         self.cell_m = float(cell_m)
         self.comm_range_m = float(comm_range_m)
         self.min_free_voxels = min_free_voxels
+        self.open_radius_m, self.max_region_m = open_radius_m, max_region_m
+        #: The base's cell, never merged into a region.
+        self.base_cell = cell_name((0, 0, 0))
         self.navigator = navigator if navigator is not None else Navigator(
             robot, _own_context(robot), rebuild_period_s=0.0)
         self._graph: NavGraph | None = None
@@ -105,13 +118,20 @@ class VoxelNetworkView:
         ground = self.ground_point()
         if locations:
             names = list(locations)
-            targets = np.array([self._home if n == self._home_cell else locations[n] for n in names], dtype=float)
+            home = self.resolve(self._home_cell)
+            targets = np.array([self._home if n == home else locations[n] for n in names], dtype=float)
             gaps = np.linalg.norm(targets - ground, axis=1)
             i = int(np.argmin(gaps))
             if gaps[i] <= ARRIVAL_RADIUS_M:
                 return names[i]
-        name = self.cell_of(ground[None])[0]
-        return name if name in locations else None
+        return self.resolve(self.cell_of(ground[None])[0])
+
+    def resolve(self, name: str) -> str | None:
+        """The location of the robot's map a name stands for: the name itself, or the
+        region it was merged into; None when the map knows no such location."""
+        topo = self.current()
+        name = topo.resolve(name)
+        return name if name in topo.locations else None
 
     def arrived(self, location: str) -> bool:
         """Whether the robot's ground point is within ``ARRIVAL_RADIUS_M`` of where it
@@ -122,8 +142,9 @@ class VoxelNetworkView:
     def route(self, location: str) -> np.ndarray | None:
         """Waypoints (N, 3) along the navigation graph from the robot to the node nearest
         the location's position or, when the graph does not reach it yet, to the
-        reachable node nearest it (if that is ``MIN_PROGRESS_M`` nearer than the robot);
-        None for an unknown location or when no such node is reachable."""
+        reachable node nearest it (if that is ``MIN_PROGRESS_M`` nearer than the robot),
+        else straight to it if the straight line crosses only known free space; None
+        for an unknown location or when none of these is possible."""
         pos = self.target(location)
         if pos is None:
             return None
@@ -132,14 +153,23 @@ class VoxelNetworkView:
         if target is None and self.navigator.map_changed():
             plan, target = self._plan_towards(goal, force=True)
         if plan is None:
-            return None
+            return self._straight(goal)
         if target is None:
             reachable = np.flatnonzero(np.isfinite(plan.distances))
             gap = np.linalg.norm(plan.graph.positions[reachable] - goal, axis=1)
             target = int(reachable[np.argmin(gap)])
             if gap.min() > np.linalg.norm(np.asarray(self.robot.position) - goal) - MIN_PROGRESS_M:
-                return None
+                return self._straight(goal)
         return plan.path_to(target)
+
+    def _straight(self, goal: np.ndarray) -> np.ndarray | None:
+        """A straight route to ``goal`` (body height) where the straight line from the
+        robot crosses only known-free voxels, else None: across an open yard the LiDAR
+        sees the floor in rings far apart, and the graph may reach no nearer node."""
+        start = np.asarray(self.robot.position, dtype=float)
+        if not line_of_sight(self.navigator.grid(), start[None], goal[None])[0]:
+            return None
+        return np.stack([start, goal])
 
     def _plan_towards(self, goal: np.ndarray, force: bool) -> tuple[Plan | None, int | None]:
         """Shortest paths from the robot (on a graph rebuilt first if ``force``) and the
@@ -151,13 +181,16 @@ class VoxelNetworkView:
         return plan, target if target is not None and np.isfinite(plan.distances[target]) else None
 
     def target(self, location: str) -> np.ndarray | None:
-        """The ground point the robot goes to for a location: the location's position
-        or, in the cell of the robot's home, its home (so each robot of a team comes
-        back to its own start pose); None for an unknown location."""
-        pos = self.current().locations.get(location)
-        if pos is None:
+        """The ground point the robot goes to for a location (or a name merged into
+        it): the location's position or, in the location of the robot's home, its
+        home (so each robot of a team comes back to its own start pose); None for an
+        unknown location."""
+        name = self.resolve(location)
+        if name is None:
             return None
-        return self._home.copy() if location == self._home_cell else np.asarray(pos, dtype=float)
+        if name == self.resolve(self._home_cell):
+            return self._home.copy()
+        return np.asarray(self.current().locations[name], dtype=float)
 
     def cell_of(self, points: np.ndarray) -> list[str]:
         """The names of the lattice cells of ground points (N, 3)."""
@@ -172,24 +205,34 @@ class VoxelNetworkView:
     # -- helpers ----------------------------------------------------------------------------
     def current(self) -> Topology:
         """The cached :class:`Topology`, extracted again if the navigation graph was
-        rebuilt, with the cells of the traversed path marked explored."""
-        graph = self.navigator.graph()
-        if graph is not self._graph:
-            grid = self.navigator.grid()
-            self._topology = extract_topology(
-                grid.occupancy, grid.origin, grid.voxel_size_m, standable=self.standable(grid, graph),
-                passable=grid.occupancy == FREE, free=grid.free, cell_m=self.cell_m,
-                comm_range_m=self.comm_range_m, min_free_voxels=self.min_free_voxels,
-                sight_height_m=self.sight_height_m(), lattice_origin=self.lattice_origin)
-            self._graph = graph
-            self.extractions += 1
+        rebuilt, with the cells of the traversed path marked explored (the
+        extraction merges only explored cells into regions)."""
         trail = self.robot.traversed_path
         if len(trail) > self._trail_seen:
             new = np.asarray(trail[self._trail_seen:], dtype=float).reshape(-1, 3)
             self._visited.update(self.cell_of(self.ground_points(new)))
             self._trail_seen = len(trail)
-        self._topology.explored |= self._visited & self._topology.locations.keys()
+        graph = self.navigator.graph()
+        if graph is not self._graph:
+            grid = self.navigator.grid()
+            self._topology = extract_topology(
+                grid.occupancy, grid.origin, grid.voxel_size_m, standable=self.standable(grid, graph),
+                visited=self._cell_centres(self._visited),
+                passable=grid.occupancy == FREE, free=grid.free, cell_m=self.cell_m,
+                comm_range_m=self.comm_range_m, min_free_voxels=self.min_free_voxels,
+                sight_height_m=self.sight_height_m(), lattice_origin=self.lattice_origin,
+                open_radius_m=self.open_radius_m, max_region_m=self.max_region_m,
+                prior=self._topology.merged, keep=(self.base_cell,))
+            self._graph = graph
+            self.extractions += 1
+        visited = {self._topology.resolve(c) for c in self._visited}
+        self._topology.explored |= visited & self._topology.locations.keys()
         return self._topology
+
+    def _cell_centres(self, cells: set[str]) -> np.ndarray:
+        """(N, 3) centres of lattice cells given by name."""
+        idx = np.array([cell_of_name(c) for c in sorted(cells)], dtype=float).reshape(-1, 3)
+        return self.lattice_origin + (idx + 0.5) * self.cell_m
 
     def standable(self, grid: Grid, graph: NavGraph) -> np.ndarray:
         """Bool mask of the voxels the robot stands on (legged) or flies through (aerial)."""

@@ -90,7 +90,8 @@ def test_names_stay_as_the_map_grows():
     for name in first.locations:
         assert second.resolve(name) in second.locations
     assert first.merged.items() <= second.merged.items()
-    assert room in first.frontiers() and second.frontiers() == set()
+    assert room in first.frontiers()        # its explored cells, next to the cells not yet explored
+    assert second.frontiers() == set()
 
 
 def test_kept_cells_are_never_merged():
@@ -126,6 +127,7 @@ def test_topologies_merge_regions_that_share_a_cell_whatever_the_order():
         for i in range(4):
             t.add_mobility_edge(f"c{i}_0_0", f"c{i + 1}_0_0")
         t.merged = dict(merged)
+    b.unreachable = {"c3_0_0"}
     ab, ba = Topology(), Topology()
     for t, order in ((ab, (a, b)), (ba, (b, a))):
         for other in order:
@@ -136,3 +138,4 @@ def test_topologies_merge_regions_that_share_a_cell_whatever_the_order():
     assert set(ab.mobility) == {("c0_0_0", "c1_0_0"), ("c1_0_0", "c4_0_0")}
     assert ab.explored == {"c0_0_0", "c1_0_0"} and ab.frontiers() == {"c1_0_0"}
     assert ab.members("c3_0_0") == ["c1_0_0", "c2_0_0", "c3_0_0"]
+    assert ab.unreachable == set()      # a cell one robot could not reach does not make its region unreachable

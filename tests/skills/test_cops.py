@@ -9,8 +9,8 @@ import pytest
 from delve.planners.cops.plan import Communication, CyclePlan, ExplorationTask, Plan
 from delve.planners.cops.topology import Topology
 from delve.skills.base import AgentContext
-from delve.skills.cops import (CommunicationAction, ExplorationAction, InformationStorage, Knowledge,
-                               MissionComplete, SolveCOPS, TransitionAction, message_id)
+from delve.skills.cops import (CommunicationAction, ExplorationAction, GreetBase, InformationStorage, Knowledge,
+                               LeavePlan, MissionComplete, SolveCOPS, TransitionAction, TransitToBase, message_id)
 from py_trees.common import Status
 
 
@@ -353,4 +353,113 @@ def test_robots_coming_back_by_the_standing_order_are_planned_static_at_the_base
     assert set(cyc.exploration) == {"r2"} and set(cyc.pre.trajectories["r1"]) == {"s0"}
     _, cyc = solve._plan(st, {"base": "s0", "r1": "s0"}, ["r1"])
     assert set(cyc.exploration) == {"r1"}
+    py_trees.blackboard.Blackboard.clear()
+
+
+def walker_context(robot, events: list, **services) -> AgentContext:
+    py_trees.blackboard.Blackboard.clear()
+    return AgentContext(name="r1", namespace="/r1", clock=SimpleNamespace(now_s=0.0),
+                        log=lambda event, **f: events.append((event, f)), robot=robot,
+                        services={"network_view": robot, **services})
+
+
+def test_a_failed_transition_is_an_event_with_its_reason():
+    """The plan sends r1 from s0 to s1, which it cannot reach: the tree fails and the
+    log says who, from where, to where and why."""
+    events: list = []
+    ctx = walker_context(BlockedWalker(at=0, blocked={"s1"}), events)
+    action = TransitionAction("Transition action", ctx)
+    step = Plan(horizon=1, trajectories={"r1": ["s0", "s1"]}, masters=["r1"], phase="pre")
+    st = action.state
+    st.plan, st.cycle, st.part, st.step = CyclePlan(step, step, {}), 2, "pre", 0
+    action.tick_once()
+    assert action.status == Status.FAILURE
+    assert [f for e, f in events if e == "cops_transition_failed"] == [
+        {"agent": "r1", "node": "Transition action", "robot": "r1", "cycle": 2, "part": "pre", "step": 0,
+         "reason": "no route to s1", "from": "s0", "to": "s1"}]
+    py_trees.blackboard.Blackboard.clear()
+
+
+class RegionWalker(Walker):
+    """A Walker whose view merged s1 and s2 into region s1 (it resolves names)."""
+
+    def resolve(self, name: str) -> str | None:
+        return {"s2": "s1"}.get(name, name)
+
+
+def test_a_name_merged_into_a_region_is_driven_to_under_the_region_s_name():
+    events: list = []
+    robot = RegionWalker(at=0)
+    ctx = walker_context(robot, events)
+    action = TransitionAction("Transition action", ctx)
+    step = Plan(horizon=1, trajectories={"r1": ["s0", "s2"]}, masters=["r1"], phase="pre")
+    st = action.state
+    st.plan, st.cycle, st.part, st.step = CyclePlan(step, step, {}), 2, "pre", 0
+    action.tick_once()
+    assert robot.goal == 1          # the region's name: s1
+    robot.step()
+    action.tick_once()
+    assert action.status == Status.SUCCESS and st.step == 1 and events == []
+    py_trees.blackboard.Blackboard.clear()
+
+
+def test_a_robot_home_by_endurance_leaves_the_plan_goes_to_the_base_and_says_so():
+    events: list = []
+    robot = Walker(at=3)
+    radio = Radio()
+    ctx = walker_context(robot, events, base_location="s0", radio=radio)
+    ctx.robot.radio = radio
+    leave, home, greet = (LeavePlan("Leave the plan", ctx), TransitToBase("Transit to base", ctx),
+                          GreetBase("Tell the base", ctx, greetings=2, greet_period_s=5.0))
+    leave.tick_once()
+    st = leave.state
+    assert leave.status == Status.SUCCESS and st.knowledge.home_by_endurance == {"r1": 0.0}
+    assert [e for e, _ in events] == ["cops_home_by_endurance"] and events[0][1]["at"] == "s3"
+    for _ in range(3):
+        home.tick_once()
+        assert home.status == Status.RUNNING
+        robot.step()
+    home.tick_once()
+    assert home.status == Status.SUCCESS and robot.location() == "s0"
+    for now in (0.0, 5.0, 10.0):
+        ctx.clock.now_s = now
+        greet.tick_once()
+    assert greet.status == Status.SUCCESS
+    hellos = [d for to, _k, d in radio.sent if to == "base" and d["type"] == "hello"]
+    assert len(hellos) == 2 and hellos[0]["payload"]["home_by_endurance"] == {"r1": 0.0}
+    py_trees.blackboard.Blackboard.clear()
+
+
+def test_the_team_plans_without_a_robot_home_by_endurance(relay):
+    """r4 went home by endurance: r3 does not wait for it, and the leader neither plans
+    it nor waits for it at the end."""
+    relay.st.knowledge.home_by_endurance["r4"] = 10.0
+    relay.action.tick_once()
+    assert [d["info"] for d in relay.radio.infos()] == ["r2"]
+    ctx, storage, done, st = final_state("base", {"radio": Radio(), "team": {"r1": "s0"}})
+    st.knowledge.home_by_endurance["r1"] = 60.0
+    done.tick_once()
+    assert done.status == Status.SUCCESS and "r1" not in st.knowledge.lost
+    st.base_location = "s0"
+    positions, returning = SolveCOPS("COPS", ctx)._positions(st, {"r1": "s0", "r2": "s0"})
+    assert positions == {"r2": "s0"} and returning == []
+    py_trees.blackboard.Blackboard.clear()
+
+
+def test_with_every_robot_home_by_endurance_the_leader_plans_the_last_recall():
+    """Frontiers are left, but nobody to explore them: the mission is over, not failed."""
+    events: list = []
+    py_trees.blackboard.Blackboard.clear()
+    ctx = AgentContext(name="base", namespace="/base", clock=SimpleNamespace(now_s=0.0),
+                       log=lambda event, **f: events.append(event),
+                       services={"base_location": "s0", "team": {"r1": "s0"}})
+    solve = SolveCOPS("COPS", ctx, time_limit_s=5.0)
+    st = solve.state
+    for i in range(3):
+        st.knowledge.topology.add_location(f"s{i}", (50.0 * i, 0.0, 0.0), explored=i < 2)
+    for i in range(2):
+        st.knowledge.topology.add_mobility_edge(f"s{i}", f"s{i + 1}", 50.0)
+    st.knowledge.home_by_endurance["r1"] = 5.0
+    solve.tick_once()
+    assert solve.status == Status.SUCCESS and st.final and events == ["cops_plan"]
     py_trees.blackboard.Blackboard.clear()

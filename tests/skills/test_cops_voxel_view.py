@@ -166,3 +166,45 @@ def test_a_robot_at_a_locations_position_is_there_whatever_cell_its_ground_point
     topo = view.current()
     topo.locations["c1_0_0"] = tuple(view.ground_point() + [1.0, 0.0, -0.3])
     assert view.arrived("c1_0_0") and view.location() == "c1_0_0"
+
+
+@pytest.fixture(scope="module")
+def yard() -> World:
+    """A corridor 4 m wide along y = 14 m from x = 0.5 to 12 m into a 24 m x 24 m yard
+    (x 12..36 m, y 2..26 m), 3 m high."""
+    canvas = VoxelCanvas(np.array([0.0, 0.0, 0.0]), np.array([38.0, 28.0, 3.0]), V)
+    carve_tunnel(canvas, [0.5, 14.0, 0.0], [12.5, 14.0, 0.0], 4.0, 3.0)
+    carve_tunnel(canvas, [12.0, 14.0, 0.0], [36.0, 14.0, 0.0], 24.0, 3.0)
+    mesh = free_space_mesh(canvas.free, canvas.origin, V)
+    return World(name="cops-yard", voxel_size_m=V, origin=canvas.origin, free=canvas.free, mesh=mesh,
+                 start=[3.0, 14.0, 0.01])
+
+
+def test_the_explored_cells_of_a_yard_are_one_location_that_every_cell_name_of_it_reaches(yard):
+    net = RadioNetwork(RadioSpec(), yard, np.random.default_rng(0), lambda: 0.0)
+    holder: dict[str, SimRobot] = {}
+    robot = holder["r"] = SimRobot("r1", LEGGED, yard, np.array([3.0, 14.0, 0.0]),
+                                   net.add("r1", lambda: holder["r"].position))
+    view = VoxelNetworkView(robot, lattice_origin=np.array([-1.0, 10.0, -4.0]))   # c0_0_0 centred on the start
+    robot.scan()
+
+    def walk_to(x: float, y: float) -> None:
+        robot.follow_path(np.array([[x, y, robot.position[2]]]))
+        while robot.path_status == "following":
+            robot.step(DT_S)
+            robot.scan()
+
+    walk_to(24.0, 14.0)                        # along the yard's middle: cells c1..c3 of row 0 visited
+    topo = view.current()
+    assert view.location() == "c1_0_0"         # named after its cell nearest the base's
+    assert topo.members("c1_0_0") == ["c1_0_0", "c2_0_0", "c3_0_0"]
+    assert view.resolve("c3_0_0") == "c1_0_0" and view.resolve("c9_9_9") is None
+    assert view.target("c3_0_0") == pytest.approx(view.target("c1_0_0"))
+    assert topo.frontiers() == {"c1_0_0"}      # the yard's cells not explored yet stay locations
+    assert "c2_1_0" in topo.unexplored_exits("c1_0_0")
+    for x, y in ((24.0, 5.0), (32.0, 5.0), (32.0, 22.0), (16.0, 22.0), (16.0, 5.0)):
+        walk_to(x, y)
+    topo = view.current()
+    assert sorted(topo.locations) == ["c0_0_0", "c1_0_0"]      # the base's cell and the yard
+    assert len(topo.members("c1_0_0")) == 12 and "c0_0_0" not in topo.members("c1_0_0")
+    assert topo.neighbours("c0_0_0") == ["c1_0_0"] and topo.frontiers() == set()
