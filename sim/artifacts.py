@@ -407,7 +407,10 @@ def place_artifacts(world: World, *, count: int, classes=ARTIFACT_CLASSES, seed:
         place(k, near)
     # 2. every level
     z0 = feet[:, 2].min() if len(feet) else 0.0
-    band = lambda pts: np.floor((pts[:, 2] - z0) / spec.level_height_m).astype(int)  # noqa: E731
+
+    def band(pts: np.ndarray) -> np.ndarray:
+        return np.floor((pts[:, 2] - z0) / spec.level_height_m).astype(int)
+
     reachable_bands = np.unique(band(feet[placer.eligible["floor"]]))
     for b in rng.permutation(reachable_bands):
         if not todo:
