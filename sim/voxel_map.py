@@ -29,8 +29,9 @@ class VoxelMap:
         self.voxel_size_m = float(voxel_size_m)
         self.version = 0
         #: Changed voxels not yet taken, one bit each (bit ``f % 8`` of byte ``f // 8``
-        #: for flat index ``f``): an eighth of a bool grid.
-        self._dirty = np.zeros((self.occupancy.size + 7) // 8, dtype=np.uint8)
+        #: for flat index ``f``): an eighth of a bool grid, in whole 64-bit words so
+        #: that take_changes finds the changes word by word.
+        self._dirty = np.zeros(-(-self.occupancy.size // 64) * 8, dtype=np.uint8)
         self._free = np.zeros(0, dtype=np.int64)
         self._new_free: list[np.ndarray] = []
         self._free_stale = False
@@ -124,11 +125,12 @@ class VoxelMap:
 
     def take_changes(self) -> tuple[np.ndarray, np.ndarray]:
         """Flat indices (ascending) and values of the voxels changed since the last call."""
-        byte = np.flatnonzero(self._dirty)
-        bits = np.unpackbits(self._dirty[byte][:, None], axis=1, bitorder="little")
-        row, bit = np.nonzero(bits)
-        flat = byte[row] * 8 + bit
-        self._dirty[byte] = 0
+        words = self._dirty.view(np.uint64)
+        changed = np.flatnonzero(words)
+        bits = np.unpackbits(self._dirty.reshape(-1, 8)[changed].reshape(-1), bitorder="little")
+        at = np.flatnonzero(bits.view(bool))     # 0/1 bytes: a bool scan is the fast one
+        flat = changed[at >> 6] * 64 + (at & 63)
+        words[changed] = 0
         return flat, self.occupancy.reshape(-1)[flat].copy()
 
     def merge(self, flat: np.ndarray, values: np.ndarray) -> None:

@@ -108,4 +108,4 @@ def test_change_log_holds_the_last_voxel_of_the_grid():
     m.set_sphere(np.array([2.5, 2.5, 2.5]), 0.1, OCCUPIED)
     flat, values = m.take_changes()
     assert flat.tolist() == [26] and values.tolist() == [OCCUPIED]
-    assert m._dirty.nbytes == 4                      # 27 voxels, one bit each
+    assert m._dirty.nbytes == 8                      # 27 voxels, one bit each, in a 64-bit word
