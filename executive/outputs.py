@@ -19,6 +19,22 @@ from .teams import wall_clock_fields  # noqa: E402
 
 #: Report fields of every run that depend on the wall clock (team strategies add theirs).
 WALL_CLOCK_FIELDS = ("wall_time_s", "real_time_factor")
+#: Coverage fractions whose first sim time the report gives (``coverage_reached_s``):
+#: T80 and T90 of bench/exploration.py.
+COVERAGE_MILESTONES = (0.8, 0.9)
+
+
+def coverage_reached_s(samples: list, fraction: float) -> float | None:
+    """Sim time at which team coverage (``samples``: the runner's, in time order) first
+    reaches ``fraction``, interpolated linearly between samples; None when it never does."""
+    prev = None
+    for s in samples:
+        if s.team >= fraction:
+            if prev is None or s.team == prev.team:
+                return round(float(s.t), 3)
+            return round(float(prev.t + (fraction - prev.team) / (s.team - prev.team) * (s.t - prev.t)), 3)
+        prev = s
+    return None
 
 
 def report(mission: Mission, wall_time_s: float) -> dict[str, Any]:
@@ -57,6 +73,8 @@ def report(mission: Mission, wall_time_s: float) -> dict[str, Any]:
         "real_time_factor": round(sim_time / wall_time_s, 1) if wall_time_s > 0 else None,
         "coverage_fraction": last.team,
         "base_coverage_fraction": last.base,
+        "coverage_reached_s": {f"{f:.0%}": coverage_reached_s(mission.state.samples, f)
+                               for f in COVERAGE_MILESTONES},
         **mission.backend.figures(mission),
         **mission.team.figures(mission),
         "robots": robots,

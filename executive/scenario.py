@@ -288,12 +288,15 @@ def _team(doc: YamlDict, path: Path, tree_types: set[type]) -> TeamSpec:
     return TeamSpec(strategy, params)
 
 
-def load_scenario(path: str | Path, include_path: Iterable[str | Path] = ()) -> Scenario:
+def load_scenario(path: str | Path, include_path: Iterable[str | Path] = (),
+                  doc: YamlDict | None = None) -> Scenario:
     """Read and check a scenario file (not its world: see :meth:`Scenario.build_world`).
-    ``include_path``: folders its trees' includes may also resolve into."""
+    ``include_path``: folders its trees' includes may also resolve into. ``doc``: the
+    file's content as already read and changed (a sweep's overrides); paths in it
+    still resolve from ``path``."""
     include_path = tuple(Path(p) for p in include_path)
     path = Path(path)
-    doc = load_yaml(path)
+    doc = load_yaml(path) if doc is None else doc
     if not isinstance(doc, YamlDict):
         raise DelveError("a scenario file must be a mapping", path, getattr(doc, "line", 1))
     if ("type" in doc or "include" in doc) and not scenario_keys({k: v for k, v in doc.items()

@@ -1,0 +1,193 @@
+"""Sweep files (executive/sweep_spec.py), a run's marker (sweep_run.py) and the results
+table and plots (sweep_table.py), without running a mission; the sweeps that run
+missions on a LocalCluster are in tests/scenarios/test_sweep.py."""
+import json
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+from delve.executive.cli import main
+from delve.executive.errors import DelveError
+from delve.executive.sweep_run import MARKER, finished_record, one_line
+from delve.executive.sweep_spec import Override, apply_overrides, load_sweep
+from delve.executive.sweep_table import figure_columns, flatten, plot_figures, results_table, write_table
+from delve.executive.yamlio import loads_yaml
+
+SMALL = Path(__file__).parent.parent / "scenarios" / "data" / "small_tunnel.yaml"
+
+
+def sweep_file(tmp_path: Path, text: str) -> Path:
+    path = tmp_path / "s.yaml"
+    path.write_text(text.replace("SMALL", str(SMALL)))
+    return path
+
+
+def cli_error(path: Path, capsys) -> str:
+    """Run ``delve sweep`` on a wrong file: exit 2, one line, no traceback; the line."""
+    assert main(["sweep", str(path), "--out", str(path.parent / "out"), "--quiet"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "Traceback" not in err, err
+    assert not (path.parent / "out").exists(), "nothing runs before the sweep is checked"
+    return err
+
+
+def test_grid_times_runs_times_seeds_in_file_order(tmp_path):
+    path = sweep_file(tmp_path, """
+scenarios: [SMALL]
+seeds: {count: 2, first: 5}
+grid:
+  radio.range_m: [30, 60]
+runs:
+  - {}
+  - {label: short, set: {duration_s: 100, world.loops: 0}}
+""")
+    sweep = load_sweep(path)
+    assert [r.run_id for r in sweep.runs] == [
+        "small_tunnel-radio.range_m=30-s5", "small_tunnel-radio.range_m=30-s6",
+        "small_tunnel-radio.range_m=60-s5", "small_tunnel-radio.range_m=60-s6",
+        "small_tunnel-short-radio.range_m=30-s5", "small_tunnel-short-radio.range_m=30-s6",
+        "small_tunnel-short-radio.range_m=60-s5", "small_tunnel-short-radio.range_m=60-s6"]
+    assert sweep.override_paths == ("radio.range_m", "duration_s", "world.loops")
+    assert sweep.name == "s"
+    assert load_sweep(path).runs == sweep.runs, "ids and digests are stable"
+    assert len({r.digest for r in sweep.runs}) == 8
+
+
+def test_without_seeds_each_scenario_keeps_its_own(tmp_path):
+    sweep = load_sweep(sweep_file(tmp_path, "scenarios: [SMALL]\ngrid: {world.total_length_m: [100, 140]}\n"))
+    assert [(r.run_id, r.seed) for r in sweep.runs] == [("small_tunnel-world.total_length_m=100-s4", 4),
+                                                         ("small_tunnel-world.total_length_m=140-s4", 4)]
+
+
+def test_a_path_value_shows_its_file_name_and_a_list_a_digest(tmp_path):
+    sweep = load_sweep(sweep_file(tmp_path, """
+scenarios: [SMALL]
+grid:
+  robots.0.tree: [../../../trees/gbplanner_explorer.yaml]
+  robots.0.start: [[0, 0, 0]]
+"""))
+    (run,) = sweep.runs
+    assert run.run_id.startswith("small_tunnel-robots.0.tree=gbplanner_explorer.yaml-robots.0.start=h")
+
+
+def test_overrides_make_missing_mappings_and_index_lists():
+    doc = loads_yaml("name: x\nrobots:\n  - {name: a}\n")
+    out = apply_overrides(doc, (Override("radio.range_m", 40, 3), Override("robots.0.name", "b", 4)))
+    assert out["radio"] == {"range_m": 40} and out["robots"][0]["name"] == "b"
+    assert "radio" not in doc, "the scenario's own document is left alone"
+    with pytest.raises(DelveError, match="is a list of 1") as err:
+        apply_overrides(doc, (Override("robots.3.name", "b", 7),))
+    assert err.value.line == 7
+
+
+@pytest.mark.parametrize("text, line, expect", [
+    ("scenarios: [SMALL]\ngird: {}\n", 2, "sweep: unknown key 'gird' (did you mean 'grid'?)"),
+    ("scenarios: [nope.yaml]\n", 1, "scenarios: scenario file not found: nope.yaml"),
+    ("scenarios: [SMALL]\nseeds: [1, -2]\n", 2, "seeds/1: a seed is an integer >= 0, not -2"),
+    ("scenarios: [SMALL]\nseeds: {count: 0}\n", 2, "seeds: count must be an integer >= 1, not 0"),
+    ("scenarios: [SMALL]\ngrid:\n  duration_s: 100\n", 3, "grid: 'duration_s': a non-empty list of values"),
+    ("scenarios: [SMALL]\ngrid:\n  wrold.total_length_m: [100]\n", 3,
+     "wrold.total_length_m: 100 does not fit scenario 'small_tunnel.yaml': "),
+    ("scenarios: [SMALL]\ngrid:\n  duration_s: [100, -5]\n", 3, "duration_s: -5 does not fit scenario"),
+    ("scenarios: [SMALL]\nruns:\n  - set: {robots.2.tree: x.yaml}\n", 3, "robots.2.tree: robots is a list of 1"),
+    ("scenarios: [SMALL]\nseeds: [1]\ngrid:\n  seed: [3]\n", 4, "seed: give the seeds with 'seeds:'"),
+    ("scenarios: [SMALL]\nruns:\n  - {set: {}}\n  - {set: {}}\n", 1, "two runs get the same id"),
+    ("runs:\n  - {label: x}\n", 2, "runs/0: no scenario"),
+    ("- a\n", 1, "a sweep file must be a mapping"),
+])
+def test_a_mistake_is_one_line_at_its_key(tmp_path, capsys, text, line, expect):
+    path = sweep_file(tmp_path, text)
+    err = cli_error(path, capsys)
+    assert err.startswith(f"{path}:{line}: ") or err.startswith(f"{path.name}:{line}: "), err
+    assert expect in err, err
+
+
+def test_an_override_the_scenario_refuses_names_both_files(tmp_path, capsys):
+    path = sweep_file(tmp_path, "scenarios: [SMALL]\ngrid:\n  world.total_lenght_m: [100]\n")
+    err = cli_error(path, capsys)
+    assert ":3: world.total_lenght_m: 100 does not fit scenario 'small_tunnel.yaml': " in err
+    assert "small_tunnel.yaml:" in err and "did you mean 'total_length_m'" in err, err
+
+
+def test_workers_and_scheduler_are_checked(tmp_path, capsys):
+    path = sweep_file(tmp_path, "scenarios: [SMALL]\n")
+    assert main(["sweep", str(path), "--workers", "0"]) == 2
+    assert "--workers must be >= 1" in capsys.readouterr().err
+    assert main(["sweep", str(path), "--workers", "2", "--scheduler", "tcp://127.0.0.1:1"]) == 2
+    assert "leave it out with --scheduler" in capsys.readouterr().err
+
+
+def test_a_marker_counts_only_for_the_same_run_with_its_outputs(tmp_path):
+    sweep = load_sweep(sweep_file(tmp_path, "scenarios: [SMALL]\nseeds: [1, 2]\n"))
+    a, b = sweep.runs
+    folder = tmp_path / "run"
+    folder.mkdir()
+    record = {"run_id": a.run_id, "digest": a.digest, "status": "ok", "error": "", "wall_time_s": 1.0}
+    (folder / MARKER).write_text(json.dumps(record))
+    assert finished_record(a, folder) is None, "an ok run without its report is not finished"
+    (folder / "report.json").write_text("{}")
+    assert finished_record(a, folder) == record
+    assert finished_record(b, folder) is None, "another run's marker (another seed) does not count"
+    (folder / MARKER).write_text("{not json")
+    assert finished_record(a, folder) is None
+
+
+def test_an_error_is_one_line_with_where_it_was_raised():
+    try:
+        {}["missing"]
+    except KeyError as err:
+        text = one_line(err)
+    assert text.startswith("KeyError: 'missing' (at test_sweep.py:") and "\n" not in text
+    assert one_line(DelveError("bad\nvalue", "x.yaml", 3)) == "x.yaml:3: bad value"
+
+
+REPORT = {"scenario": "small_tunnel", "seed": 1, "succeeded": True, "wall_time_s": 2.0,
+          "outcome": {"timed_out": False, "reasons": [], "lost": {}}, "coverage_fraction": 0.5,
+          "coverage_reached_s": {"80%": None, "90%": None},
+          "robots": [{"name": "anymal", "distance_m": 10.0, "start": [0, 0, 0], "safety_triggers": {"stuck": 1}}]}
+
+
+def test_flatten_keeps_numbers_words_truths_and_robots_by_name():
+    assert flatten(REPORT) == {"succeeded": True, "outcome.timed_out": False, "coverage_fraction": 0.5,
+                               "coverage_reached_s.80%": None, "coverage_reached_s.90%": None,
+                               "robots.anymal.distance_m": 10.0, "robots.anymal.safety_triggers.stuck": 1}
+
+
+def fake_sweep(tmp_path: Path):
+    """A sweep of four runs (two ranges x two seeds) with reports made up: coverage
+    grows with the range, the first run failed."""
+    sweep = load_sweep(sweep_file(tmp_path, "scenarios: [SMALL]\nseeds: [1, 2]\ngrid: {radio.range_m: [30, 60]}\n"))
+    runs_dir = tmp_path / "out" / "runs"
+    records = {}
+    for i, run in enumerate(sweep.runs):
+        ok = i > 0
+        records[run.run_id] = {"status": "ok" if ok else "failed", "error": "" if ok else "boom", "wall_time_s": 1.0}
+        (runs_dir / run.run_id).mkdir(parents=True)
+        rep = dict(REPORT, seed=run.seed, coverage_fraction=0.1 * i, succeeded=i % 2 == 0)
+        (runs_dir / run.run_id / "report.json").write_text(json.dumps(rep))
+    return sweep, records, runs_dir
+
+
+def test_the_table_has_a_row_per_run_and_reads_back_from_parquet(tmp_path):
+    sweep, records, runs_dir = fake_sweep(tmp_path)
+    table = results_table(sweep, records, runs_dir)
+    assert list(table.columns[:8]) == ["run_id", "scenario", "seed", "label", "status", "error", "wall_time_s",
+                                       "radio.range_m"]
+    assert list(table["status"]) == ["failed", "ok", "ok", "ok"]
+    assert table["coverage_fraction"].isna().tolist() == [True, False, False, False], "a failed run has no figures"
+    assert list(table["radio.range_m"]) == [30, 30, 60, 60]
+    write_table(table, tmp_path / "out")
+    back = pd.read_parquet(tmp_path / "out" / "results.parquet")
+    assert back["run_id"].tolist() == table["run_id"].tolist()
+    assert back["coverage_fraction"].tolist()[1:] == pytest.approx([0.1, 0.2, 0.3])
+    assert pd.read_csv(tmp_path / "out" / "results.csv")["status"].tolist() == ["failed", "ok", "ok", "ok"]
+
+
+def test_one_plot_per_figure_that_varies(tmp_path):
+    sweep, records, runs_dir = fake_sweep(tmp_path)
+    table = results_table(sweep, records, runs_dir)
+    assert figure_columns(table, sweep) == ["succeeded", "coverage_fraction"]
+    written = plot_figures(table, sweep, tmp_path / "plots")
+    assert [p.name for p in written] == ["succeeded.png", "coverage_fraction.png"]
+    assert all(p.stat().st_size > 1000 for p in written)
