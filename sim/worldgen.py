@@ -26,10 +26,12 @@ from .world import World
 from .worldgen_cave import (CAVE_FLOOR_BAND_M, CavePlan, add_cave_branches, add_cave_upper,
                             build_cave)
 from .worldgen_geometry import CLEARANCE_M, cave_section_top, snap_height
+from .worldgen_subt import (CAVE_WIDTH_M, CAVE_HEIGHT_M, build_course, check_slope)
+from .worldgen_subt_urban import WALL_M
 from .worldgen_mine import (LATTICE_DIRECTIONS, LEVEL_RISE_M, MinePlan, add_gallery,
                             add_upper_level, build_mine, mine_regions)
 
-__all__ = ["tunnel_network", "cave", "from_mesh", "scanned_mine", "write_scanned_mine",
+__all__ = ["tunnel_network", "cave", "subt_final", "from_mesh", "scanned_mine", "write_scanned_mine",
            "SCANNED_MINE_PATH"]
 
 #: The "scanned mine" test asset: a small mine mesh with scan noise, Y-up, in centimetres.
@@ -52,6 +54,8 @@ CAVE_RADIUS_M = 10.0
 CAVE_RADIUS_PER_LENGTH = 0.12
 #: ... and the passage above a cave shaft takes this share of it (8-40 m).
 CAVE_UPPER_SHARE = 0.12
+#: Widest and highest cavern of a SubT Final course (m).
+CAVERN_MAX_M = 40.0
 
 
 # ============================================================== validation
@@ -245,6 +249,50 @@ def cave(seed: int, *, total_length_m: float = 250.0, width_m: tuple = (1.0, 15.
         raise ValueError(f"cannot fit a {total:g} m cave (only {got:.0f} m fitted): "
                          f"lower total_length_m or the widths")
     return build_cave(plan, name, v)
+
+
+def subt_final(seed: int, *, scale: float = 1.0, tunnel_length_m: float = 700.0,
+               urban_length_m: float = 450.0, cave_length_m: float = 550.0,
+               entrance_slope_deg: float = 15.0, stair_slope_deg: float = 25.0,
+               cavern_width_m: float = 20.0, cavern_height_m: float = 10.0,
+               voxel_size_m: float = 0.2, name: str = "subt_final") -> World:
+    """A seeded course like the DARPA SubT Final's (sim/worldgen_subt.py, docs/worlds.md).
+
+    From the portal (the start) an inclined drift (``entrance_slope_deg``) with a
+    sharp turn leads into a high hall with three breaches: east into a Tunnel
+    section (parallel drifts, crosscuts, side cuts), north into an Urban section
+    (two levels of square corridors and rooms with doors, a staircase at
+    ``stair_slope_deg``), south into a Cave section (narrow meandering passages
+    and a cavern ``cavern_width_m`` wide and up to ``cavern_height_m`` high). A
+    descending staircase and a drift cross over from the upper urban level to the
+    tunnel drifts, and a drift from the tunnel meets the cave. Each section's
+    centreline is ``scale`` times its ``*_length_m`` (within 10 %); the entrance
+    (about 43 m), the hall (40 m) and the crossovers come on top: about 1.8 km in
+    all at the defaults. Nodes carry ``pos``, ``level`` (1 on the upper urban
+    level) and ``section`` (entrance, hall, tunnel, urban, cave); edges
+    ``width_m``, ``height_m``, ``kind`` (ramp, tunnel, hall, corridor, stairs,
+    room, cave), ``length_m`` and ``section``. Raises ValueError for impossible
+    parameters.
+    """
+    k = _check_positive("scale", scale)
+    lengths = {s: k * _check_positive(f"{s}_length_m", value) for s, value in
+               (("tunnel", tunnel_length_m), ("urban", urban_length_m), ("cave", cave_length_m))}
+    v = _check_positive("voxel_size_m", voxel_size_m)
+    if v > 0.5 * WALL_M:
+        raise ValueError(f"voxel_size_m must be at most {0.5 * WALL_M:g} m (half the urban "
+                         f"rooms' walls), got {v:g}")
+    entrance = check_slope("entrance_slope_deg", entrance_slope_deg)
+    stairs = check_slope("stair_slope_deg", stair_slope_deg)
+    cw = _check_positive("cavern_width_m", cavern_width_m)
+    ch = _check_positive("cavern_height_m", cavern_height_m)
+    if not 2 * CAVE_WIDTH_M[1] <= cw <= CAVERN_MAX_M:
+        raise ValueError(f"cavern_width_m must lie in [{2 * CAVE_WIDTH_M[1]:g}, {CAVERN_MAX_M:g}] "
+                         f"(at least twice the widest passage), got {cw:g}")
+    if not CAVE_HEIGHT_M[1] <= ch <= CAVERN_MAX_M:
+        raise ValueError(f"cavern_height_m must lie in [{CAVE_HEIGHT_M[1]:g}, {CAVERN_MAX_M:g}], "
+                         f"got {ch:g}")
+    check_total_length(sum(lengths.values()))
+    return build_course(seed, lengths, entrance, stairs, cw, ch, v, name)
 
 
 # ============================================================ test assets

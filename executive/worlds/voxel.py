@@ -44,10 +44,12 @@ class VoxelBackend(WorldBackend):
 
     KEYS = ("generator", "mesh")
     COVERAGE_LABEL = "fraction of free volume observed"
+    ARTIFACTS = True
 
     @classmethod
     def generators(cls) -> dict[str, Any]:
-        return {"tunnel_network": worldgen.tunnel_network, "cave": worldgen.cave}
+        return {"tunnel_network": worldgen.tunnel_network, "cave": worldgen.cave,
+                "subt_final": worldgen.subt_final}
 
     @classmethod
     def claims(cls, world: Mapping[str, Any]) -> bool:
@@ -114,7 +116,9 @@ class VoxelBackend(WorldBackend):
         base = PLATFORMS[spec.platform]
         platform = replace(base, **spec.overrides, lidar=replace(base.lidar, **spec.lidar))
         holder: dict[str, SimRobot] = {}
-        radio = self.radio.add(spec.name, lambda: holder["r"].true_position, breadcrumbs=spec.breadcrumbs)
+        # Aerial robots are WiFi clients of the mesh, not relays (CERBERUS section 3.4).
+        radio = self.radio.add(spec.name, lambda: holder["r"].true_position, breadcrumbs=spec.breadcrumbs,
+                               relay=not platform.aerial)
         robot = SimRobot(spec.name, platform, self.world, start, radio, spec.endurance_s)
         holder["r"] = robot
         return robot
