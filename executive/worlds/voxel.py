@@ -44,7 +44,6 @@ class VoxelBackend(WorldBackend):
 
     KEYS = ("generator", "mesh")
     COVERAGE_LABEL = "fraction of free volume observed"
-    ARTIFACTS = True
 
     @classmethod
     def generators(cls) -> dict[str, Any]:
@@ -116,9 +115,7 @@ class VoxelBackend(WorldBackend):
         base = PLATFORMS[spec.platform]
         platform = replace(base, **spec.overrides, lidar=replace(base.lidar, **spec.lidar))
         holder: dict[str, SimRobot] = {}
-        # Aerial robots are WiFi clients of the mesh, not relays (CERBERUS section 3.4).
-        radio = self.radio.add(spec.name, lambda: holder["r"].true_position, breadcrumbs=spec.breadcrumbs,
-                               relay=not platform.aerial)
+        radio = self.radio.add(spec.name, lambda: holder["r"].true_position, breadcrumbs=spec.breadcrumbs)
         robot = SimRobot(spec.name, platform, self.world, start, radio, spec.endurance_s)
         holder["r"] = robot
         return robot
