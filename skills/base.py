@@ -14,6 +14,7 @@ from __future__ import annotations
 import copy
 import math
 import re
+from collections import deque
 from dataclasses import dataclass, field
 from typing import Any, Callable, ClassVar, Protocol
 
@@ -227,6 +228,41 @@ class AgentContext:
     robot: Robot | None = None
     params: dict[str, Any] = field(default_factory=dict)
     services: dict[str, Any] = field(default_factory=dict)
+
+
+#: ``ctx.services`` key of the agent's :class:`Mailbox`.
+MAILBOX = "mailbox"
+#: Messages a mailbox keeps of one kind that no behaviour takes (the oldest go first).
+MAILBOX_LIMIT = 1000
+
+
+class Mailbox:
+    """An agent's delivered messages sorted by kind, so that several behaviours can
+    each take their own: the radio's ``receive()`` hands every message out once, and
+    a behaviour that took them all would lose the others' messages. Each
+    :meth:`take` first moves what the radio delivered since into per-kind queues."""
+
+    def __init__(self, radio: Any):
+        self.radio = radio
+        self.queues: dict[str, deque[Any]] = {}
+
+    def take(self, kind: str) -> list[Any]:
+        """The messages of ``kind`` delivered and not yet taken, oldest first."""
+        for msg in self.radio.receive():
+            self.queues.setdefault(msg.kind, deque(maxlen=MAILBOX_LIMIT)).append(msg)
+        queue = self.queues.get(kind)
+        out = list(queue) if queue else []
+        if queue:
+            queue.clear()
+        return out
+
+
+def mailbox(ctx: AgentContext, radio: Any) -> Mailbox:
+    """The agent's :class:`Mailbox` on ``radio`` (created on first use, in ``ctx.services``)."""
+    box = ctx.services.get(MAILBOX)
+    if box is None or box.radio is not radio:
+        box = ctx.services[MAILBOX] = Mailbox(radio)
+    return box
 
 
 def resolve_key(key: str, namespace: str, remap: dict[str, str] | None = None) -> str:

@@ -190,4 +190,37 @@ class Home(PathMotion):
         return Status.FAILURE
 
 
-__all__ = ["EnduranceLow", "Home"]
+class EndSortie(Skill):
+    """Home after homing: the mission ends, or only the sortie does.
+
+    The CERBERUS supervisor sent robots on short budgeted sorties and re-tasked them
+    when they came back, so homing ends a sortie; it ends the mission when the
+    supervisor called the robot home, or when no supervisor ever tasked it.
+    Reads ``end_at_home`` (written by ProcessOperatorCommands; True when unset).
+    Returns SUCCESS when it is True (the mission is over). Otherwise writes ``mode``
+    idle and clears ``time_budget_s`` and ``budget_start_s``, logs ``sortie_ended``
+    and returns FAILURE, so that the tree's lower blocks run (the last one waits for
+    the next command).
+    """
+
+    INPUT_PORTS = {"end_at_home": PortInformation(bool, required=False, default_value=True,
+                                                  description="True: homing ends the mission")}
+    OUTPUT_PORTS = {
+        "mode": PortInformation(str, description="``idle`` after a sortie"),
+        "time_budget_s": PortInformation(float | None, description="cleared after a sortie"),
+        "budget_start_s": PortInformation(float | None, description="cleared after a sortie"),
+    }
+
+    def update(self) -> Status:
+        if self.read("end_at_home", True):
+            self.feedback_message = "home: the mission is over"
+            return Status.SUCCESS
+        self.write("mode", "idle")
+        self.write("time_budget_s", None)
+        self.write("budget_start_s", None)
+        self.feedback_message = "home from a sortie: waiting for commands"
+        self.event("sortie_ended", endurance_s=round(self.robot.endurance_remaining_s, 1))
+        return Status.FAILURE
+
+
+__all__ = ["EndSortie", "EnduranceLow", "Home"]

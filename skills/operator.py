@@ -14,7 +14,7 @@ from typing import Any
 from py_trees.common import Status
 from py_trees.ports import PortInformation
 
-from .base import Param, Skill
+from .base import Param, Skill, mailbox
 
 COMMAND = "command"
 GOAL_UNREACHABLE = "goal_unreachable"
@@ -35,22 +35,37 @@ COMMANDS: dict[str, dict[str, Param]] = {
 
 #: Blackboard values of ``mode``.
 MODES = ("idle", "explore", "relocate", "goto", "home")
+#: Commands that give the robot a new task: each replaces the running one and its
+#: time budget (``explore`` sets its own).
+TASKS = ("explore", "relocate", "goto", "home", "cancel")
 
 
 class ProcessOperatorCommands(Skill):
     """Process Operator Calls: apply every supervisor command that has arrived.
 
-    Reads radio messages of kind ``command`` (kept in the outbox of the base station
-    while the link is down). Writes ``mode`` (idle, explore, relocate, goto, home),
+    Takes the radio messages of kind ``command`` from the agent's mailbox (they wait
+    in the base station's outbox while the link is down; other kinds stay for other
+    behaviours). Writes ``mode`` (idle, explore, relocate, goto, home),
     ``time_budget_s`` and ``budget_start_s`` (explore with a budget), ``goal`` and
     ``goal_source`` (goto), ``exploration_bbox``, ``inspection_request`` (scan),
-    ``breadcrumb_request`` and ``last_command``. Commands take priority over onboard
-    requests: a new command replaces the running one. Returns RUNNING (it is a
-    background task).
+    ``breadcrumb_request``, ``end_at_home`` and ``last_command``.
+
+    Commands take priority over onboard requests: a task (explore, relocate, goto,
+    home, cancel) replaces the running one and clears its time budget (explore sets
+    its own). ``end_at_home`` says whether homing ends the mission (True) or only a
+    sortie, after which the robot waits at home for its next command (False): it
+    starts as ``end_at_home`` (an unsupervised robot's mission ends at home), the
+    ``home`` command sets it, and the other tasks clear it (the supervisor will send
+    the robot out again, or call it home). Returns RUNNING (it is a background task).
     """
 
-    PARAMS = {"initial_mode": Param(str, "idle", "mode before the first command", choices=MODES)}
-    #: Set up with ``initial_mode``, ``False`` for ``breadcrumb_request`` and null for the rest.
+    PARAMS = {
+        "initial_mode": Param(str, "idle", "mode before the first command", choices=MODES),
+        "end_at_home": Param(bool, True, "whether homing ends the mission until a task command other than "
+                                         "home arrives (then homing ends a sortie)"),
+    }
+    #: Set up with ``initial_mode``, ``end_at_home``, ``False`` for ``breadcrumb_request``
+    #: and null for the rest.
     OUTPUT_PORTS = {
         "mode": PortInformation(str, description="the mode of operation: " + ", ".join(MODES)),
         "time_budget_s": PortInformation(float | None, description="explore's time budget (s); null: none"),
@@ -61,6 +76,8 @@ class ProcessOperatorCommands(Skill):
                                             "bounding box (m)"),
         "inspection_request": PortInformation(dict | None, description="scan's request: {point, requested_s}"),
         "breadcrumb_request": PortInformation(bool, description="True when a breadcrumb is to be dropped"),
+        "end_at_home": PortInformation(bool, description="True: homing ends the mission; False: it ends a sortie "
+                                       "and the robot waits at home for commands"),
         "last_command": PortInformation(str | None, description="the last command applied"),
     }
 
@@ -69,21 +86,23 @@ class ProcessOperatorCommands(Skill):
         for k in ("time_budget_s", "budget_start_s", "goal", "goal_source", "exploration_bbox", "inspection_request"):
             self.write(k, None)
         self.write("breadcrumb_request", False)
+        self.write("end_at_home", self.p["end_at_home"])
         self.write("last_command", None)
 
     def update(self) -> Status:
-        for msg in self.robot.radio.receive():
-            if msg.kind == COMMAND:
-                self._apply(msg.data["command"], msg.data.get("args", {}))
+        for msg in mailbox(self.ctx, self.robot.radio).take(COMMAND):
+            self._apply(msg.data["command"], msg.data.get("args", {}))
         return Status.RUNNING
 
     def _apply(self, command: str, args: dict[str, Any]) -> None:
         now, set_ = self.ctx.clock.now_s, self.write
-        if command == "explore":
-            set_("mode", "explore")
-            budget = args.get("budget_s")
+        if command in TASKS:
+            budget = args.get("budget_s") if command == "explore" else None
             set_("time_budget_s", budget)
             set_("budget_start_s", now if budget is not None else None)
+            set_("end_at_home", command == "home")
+        if command == "explore":
+            set_("mode", "explore")
         elif command == "set_bbox":
             set_("exploration_bbox", [list(args["min"]), list(args["max"])])
         elif command in ("home", "relocate"):

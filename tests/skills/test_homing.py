@@ -284,3 +284,24 @@ def test_explore_until_endurance_low_then_return_home():
     # 100 - t <= 1.2 t + 60: turned back after ~18 s, ~18 m out; home with ~60 s to spare.
     assert 15.0 <= farthest <= 21.0
     assert robot.endurance_remaining_s >= 55.0
+
+
+# ---------------------------------------------------------------------------- EndSortie
+
+
+def test_end_sortie_ends_the_mission_unless_the_supervisor_will_send_the_robot_out_again(tunnel):
+    grid, a, _ = tunnel
+    ctx = make_ctx(FakeRobot(grid, body(a, 2.0)))
+    end = build("type: EndSortie", ctx)
+    end.tick_once()
+    assert end.status == Status.SUCCESS  # never tasked: the mission ends at home
+    py_trees.blackboard.Blackboard.set("/r1/end_at_home", True)
+    end.tick_once()
+    assert end.status == Status.SUCCESS and not events(ctx, "sortie_ended")
+    for key, value in (("end_at_home", False), ("mode", "home"), ("time_budget_s", 300.0),
+                       ("budget_start_s", 10.0)):
+        py_trees.blackboard.Blackboard.set(f"/r1/{key}", value)
+    end.tick_once()
+    assert end.status == Status.FAILURE  # a sortie ended: lower blocks run, the last waits
+    assert (bb("mode"), bb("time_budget_s"), bb("budget_start_s")) == ("idle", None, None)
+    assert len(events(ctx, "sortie_ended")) == 1

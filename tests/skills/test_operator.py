@@ -6,13 +6,14 @@ import py_trees
 import pytest
 from delve.executive.errors import DelveError
 from delve.planners.gbplanner2 import synthetic as syn
-from delve.skills.operator import COMMAND, COMMANDS, MODES
+from delve.skills.base import mailbox
+from delve.skills.operator import COMMAND, COMMANDS, MODES, TASKS
 from py_trees.common import Status
 
 from .fakes import FakeRobot, bb, body, build, events, make_ctx
 
 KEYS = ("mode", "time_budget_s", "budget_start_s", "goal", "goal_source", "exploration_bbox",
-        "inspection_request", "breadcrumb_request", "last_command")
+        "inspection_request", "breadcrumb_request", "end_at_home", "last_command")
 
 
 @pytest.fixture(scope="module")
@@ -41,7 +42,7 @@ def state() -> dict:
 def test_setup_writes_the_initial_state(agent):
     assert state() == {"mode": "idle", "time_budget_s": None, "budget_start_s": None, "goal": None,
                        "goal_source": None, "exploration_bbox": None, "inspection_request": None,
-                       "breadcrumb_request": False, "last_command": None}
+                       "breadcrumb_request": False, "end_at_home": True, "last_command": None}
 
 
 def test_the_initial_mode_is_a_parameter(tunnel):
@@ -67,15 +68,16 @@ def test_nothing_changes_while_no_command_arrives(agent):
 
 #: Each command with arguments, and what it writes (on top of ``last_command``) at 42 s.
 CASES = {
-    "explore": ({"budget_s": 300.0}, {"mode": "explore", "time_budget_s": 300.0, "budget_start_s": 42.0}),
+    "explore": ({"budget_s": 300.0}, {"mode": "explore", "time_budget_s": 300.0, "budget_start_s": 42.0,
+                                      "end_at_home": False}),
     "set_bbox": ({"min": [0, -5, 0], "max": [40, 5, 4]}, {"exploration_bbox": [[0, -5, 0], [40, 5, 4]]}),
     "home": ({}, {"mode": "home"}),
-    "cancel": ({}, {"mode": "idle"}),
-    "relocate": ({}, {"mode": "relocate"}),
+    "cancel": ({}, {"mode": "idle", "end_at_home": False}),
+    "relocate": ({}, {"mode": "relocate", "end_at_home": False}),
     "scan": ({"point": [12.0, 6.0, 1.5]},
              {"inspection_request": {"point": [12.0, 6.0, 1.5], "requested_s": 42.0}}),
     "goto": ({"goal": [20.0, 6.0, 1.5]},
-             {"mode": "goto", "goal": [20.0, 6.0, 1.5], "goal_source": "supervisor"}),
+             {"mode": "goto", "goal": [20.0, 6.0, 1.5], "goal_source": "supervisor", "end_at_home": False}),
     "drop_breadcrumb": ({}, {"breadcrumb_request": True}),
 }
 
@@ -148,10 +150,40 @@ def test_commands_arriving_together_apply_in_order(agent):
     assert [e["command"] for e in events(ctx, "operator_command")] == ["goto", "drop_breadcrumb", "home"]
 
 
-def test_other_messages_are_not_commands(agent):
+def test_other_messages_are_not_commands_and_stay_for_their_takers(agent):
     robot, ctx, node = agent
     before = state()
     robot.radio.deliver("base", "map_delta", {"flat": [1, 2], "values": [0, 0]})
     robot.radio.deliver("r2", "report", {"command": "home"})
+    robot.radio.deliver("r2", "report", {"n": 2})
     node.tick_once()
     assert state() == before and not events(ctx, "operator_command")
+    box = mailbox(ctx, robot.radio)
+    assert [m.data for m in box.take("report")] == [{"command": "home"}, {"n": 2}]
+    assert box.take("report") == [] and [m.kind for m in box.take("map_delta")] == ["map_delta"]
+
+
+@pytest.mark.parametrize("name", TASKS)
+def test_a_task_replaces_the_running_budget(agent, name):
+    """A budget belongs to its explore task: any later task clears it (explore with a
+    budget sets a new one), so the homing timer cannot outrank the supervisor's next
+    command."""
+    robot, ctx, node = agent
+    ctx.clock.now_s = 10.0
+    command(robot, "explore", budget_s=120.0)
+    node.tick_once()
+    ctx.clock.now_s = 200.0
+    command(robot, name, **({"goal": [1.0, 2.0, 0.5]} if name == "goto" else {}))
+    node.tick_once()
+    assert (bb("time_budget_s"), bb("budget_start_s")) == (None, None)
+    assert bb("end_at_home") is (name == "home")
+
+
+def test_homing_ends_the_mission_only_when_the_supervisor_calls_the_robot_home(agent):
+    robot, ctx, node = agent
+    assert bb("end_at_home") is True  # no supervisor yet: the mission ends at home
+    for name, expected in (("explore", False), ("scan", False), ("home", True), ("goto", False),
+                           ("drop_breadcrumb", False), ("home", True)):
+        command(robot, name, **({"goal": [1.0, 2.0, 0.5]} if name == "goto" else {}))
+        node.tick_once()
+        assert bb("end_at_home") is expected, name

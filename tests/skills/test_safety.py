@@ -275,6 +275,7 @@ children:
 """, ctx)
     root.setup_with_descendants()
     py_trees.blackboard.Blackboard.set("/r1/time_budget_s", None)
+    py_trees.blackboard.Blackboard.set("/r1/mode", "explore")
     robot.radio.link_up = False
     statuses = tick_for(root, ctx, robot, 4.0)
     assert robot.paths == []  # two failed pings (0 s, 2 s): not yet
@@ -305,7 +306,36 @@ children:
   - include: subtrees/wifi_safety.yaml
 """, ctx)
     root.setup_with_descendants()
+    py_trees.blackboard.Blackboard.set("/r1/mode", "explore")
     py_trees.blackboard.Blackboard.set("/r1/time_budget_s", 600.0)  # out of range on purpose
     robot.radio.link_up = False
     assert set(tick_for(root, ctx, robot, 20.0)) == {Status.FAILURE}
     assert bb("failed_pings") == 10 and robot.paths == []
+
+
+def test_wifi_safety_stops_backing_off_when_the_supervisor_cancels(tunnel):
+    """The guard is checked at every tick: a task other than exploring (cancel: idle)
+    stops the back-off at once, and no back-off starts while the robot is not exploring."""
+    grid, a, _ = tunnel
+    trail = [body(a, x) for x in np.arange(2.0, 30.01, 0.5)]
+    robot = FakeRobot(grid, trail[-1], trail=trail)
+    ctx = make_ctx(robot)
+    root = build("""
+type: Parallel
+policy: success_on_selected
+selected: [WiFi safety]
+children:
+  - type: Ping
+  - include: subtrees/wifi_safety.yaml
+""", ctx)
+    root.setup_with_descendants()
+    py_trees.blackboard.Blackboard.set("/r1/time_budget_s", None)
+    py_trees.blackboard.Blackboard.set("/r1/mode", "explore")
+    robot.radio.link_up = False
+    tick_for(root, ctx, robot, 6.0)
+    assert len(robot.paths) == 1 and robot.path_status.value == "following"
+    py_trees.blackboard.Blackboard.set("/r1/mode", "idle")
+    assert tick_for(root, ctx, robot, 1.0) == [Status.FAILURE]
+    assert robot.path_status.value != "following"
+    assert set(tick_for(root, ctx, robot, 10.0)) == {Status.FAILURE} and len(robot.paths) == 1
+
