@@ -19,6 +19,7 @@ from py_trees.common import Status
 from py_trees.ports import PortInformation
 
 from ..planners.gbplanner2 import Frontier, GBPlanner, GBPlannerConfig, PlanResult
+from ..planners.gbplanner2.link_loss import LinkLoss
 from ..planners.gbplanner2.local_planner import ShrinkingLocalPlanner
 from ..planners.gbplanner2.planning_map import blocked_spot, mark_blocked_spots, sealed_grid, start_pose
 from ..planners.geometry import path_length, xyz
@@ -184,7 +185,11 @@ class Explore(Skill):
 
     Reads: ``exploration_bbox`` (optional ``{min: [x, y, z], max: [x, y, z]}`` or
     ``[min, max]``): the local graph stays inside it and only frontiers inside it are
-    repositioned to.
+    repositioned to; ``link_loss_points`` (optional, written by RememberLinkLoss):
+    the gain of vertices whose path passes within ``link_loss_radius_m`` of one is
+    multiplied by ``link_loss_gain_factor``, and frontiers beyond one are not
+    repositioned to (:mod:`delve.planners.gbplanner2.link_loss`), so that a robot
+    backed off from the radio edge explores elsewhere.
     Writes: ``planner_mode`` (explore, reposition, homing, none),
     ``last_plan_reason`` (ok, reposition, homing_due, exploration_complete,
     invalid_start, no_path, blocked, error), ``last_plan_detail`` (the planner's words),
@@ -227,10 +232,19 @@ class Explore(Skill):
                                            "(0: off)", minimum=0),
         "reroute_poses": Param(int, 5, "a blocked path is re-planned on the navigation graph to the farthest of "
                                        "this many of its poses (0: off)", minimum=0),
+        "link_loss_radius_m": Param(float, 3.0, "gain beyond a point where the radio link was lost is discounted: "
+                                    "of vertices whose path passes this close to it", exclusive_minimum=0),
+        "link_loss_gain_factor": Param(float, 0.0, "the gain beyond a link-loss point is multiplied by this",
+                                       minimum=0, maximum=1),
     }
-    INPUT_PORTS = {"exploration_bbox": PortInformation(list | dict, required=False, description="{min: [x, y, z], "
-                                                       "max: [x, y, z]} or [min, max] (m): the local graph stays "
-                                                       "inside it, only frontiers inside it are repositioned to")}
+    INPUT_PORTS = {
+        "exploration_bbox": PortInformation(list | dict, required=False, description="{min: [x, y, z], max: [x, y, "
+                                            "z]} or [min, max] (m): the local graph stays inside it, only frontiers "
+                                            "inside it are repositioned to"),
+        "link_loss_points": PortInformation(list, required=False, description="[x, y, z] points where the radio link "
+                                            "was lost (m): the gain beyond them is discounted, the frontiers beyond "
+                                            "them wait"),
+    }
     OUTPUT_PORTS = {
         "planner_mode": PortInformation(str, description="explore, reposition, homing or none"),
         "last_plan_reason": PortInformation(str, description="ok, reposition, homing_due, exploration_complete, "
@@ -419,9 +433,16 @@ class Explore(Skill):
                 del gp.frontiers[v]
         try:
             return planner.plan(grid, start_pose(grid, planner.config, r.position, self.p["start_shift_m"]), svc.rng,
-                                yaw_rad=r.yaw_rad, endurance_remaining_s=endurance, exploration_bounds=bounds)
+                                yaw_rad=r.yaw_rad, endurance_remaining_s=endurance, exploration_bounds=bounds,
+                                link_loss=self._link_loss())
         finally:
             gp.frontiers.update(hidden)
+
+    def _link_loss(self) -> LinkLoss | None:
+        points = self.read("link_loss_points")
+        if not points:
+            return None
+        return LinkLoss(np.asarray(points, float), self.p["link_loss_radius_m"], self.p["link_loss_gain_factor"])
 
     def _write(self, mode: str, code: str, detail: str) -> None:
         self.write("planner_mode", mode)

@@ -48,7 +48,9 @@ class ProcessOperatorCommands(Skill):
     behaviours). Writes ``mode`` (idle, explore, relocate, goto, home),
     ``time_budget_s`` and ``budget_start_s`` (explore with a budget), ``goal`` and
     ``goal_source`` (goto), ``exploration_bbox``, ``inspection_request`` (scan),
-    ``breadcrumb_request``, ``end_at_home`` and ``last_command``.
+    ``breadcrumb_request``, ``end_at_home`` and ``last_command``; ``explore`` also
+    clears ``link_loss_points`` (WiFi safety's memory of the radio edge: a new
+    exploring task starts afresh).
 
     Commands take priority over onboard requests: a task (explore, relocate, goto,
     home, cancel) replaces the running one and clears its time budget (explore sets
@@ -78,6 +80,7 @@ class ProcessOperatorCommands(Skill):
         "breadcrumb_request": PortInformation(bool, description="True when a breadcrumb is to be dropped"),
         "end_at_home": PortInformation(bool, description="True: homing ends the mission; False: it ends a sortie "
                                        "and the robot waits at home for commands"),
+        "link_loss_points": PortInformation(list, description="where the radio link was lost: cleared by explore"),
         "last_command": PortInformation(str | None, description="the last command applied"),
     }
 
@@ -87,6 +90,7 @@ class ProcessOperatorCommands(Skill):
             self.write(k, None)
         self.write("breadcrumb_request", False)
         self.write("end_at_home", self.p["end_at_home"])
+        self.write("link_loss_points", [])
         self.write("last_command", None)
 
     def update(self) -> Status:
@@ -103,6 +107,7 @@ class ProcessOperatorCommands(Skill):
             set_("end_at_home", command == "home")
         if command == "explore":
             set_("mode", "explore")
+            set_("link_loss_points", [])
         elif command == "set_bbox":
             set_("exploration_bbox", [list(args["min"]), list(args["max"])])
         elif command in ("home", "relocate"):

@@ -118,3 +118,30 @@ class Ping(Skill):
         return Status.RUNNING
 
 
+
+
+class RememberLinkLoss(Skill):
+    """Remember where the robot found its link to the base station lost, so that its
+    exploration discounts what lies beyond (the WiFi safety block, before it backs off).
+
+    Appends the robot's position to ``link_loss_points`` unless one of them lies
+    within ``merge_radius_m``; logs ``link_loss``. Always SUCCESS. The points are
+    cleared when the supervisor sends the robot exploring again or a breadcrumb
+    extends the mesh.
+    """
+
+    PARAMS = {"merge_radius_m": Param(float, 2.0, "a loss this close to a remembered one is the same", minimum=0)}
+    INPUT_PORTS = {"link_loss_points": PortInformation(list, required=False, default_value=[],
+                                                       description="[x, y, z] points where the link was lost")}
+    OUTPUT_PORTS = {"link_loss_points": PortInformation(list, description="[x, y, z] points where the link was "
+                                                        "lost (m)")}
+
+    def update(self) -> Status:
+        points = list(self.read("link_loss_points") or [])
+        here = self.robot.position
+        known = any(np.linalg.norm(here - np.asarray(p, float)) <= self.p["merge_radius_m"] for p in points)
+        if not known:
+            points.append(xyz(here, 2))
+            self.write("link_loss_points", points)
+        self.event("link_loss", at=xyz(here, 2), remembered=len(points), new=not known)
+        return Status.SUCCESS

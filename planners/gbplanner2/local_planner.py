@@ -33,6 +33,7 @@ from .bounds import LocalBound, adaptive_local_bound
 from .config import GBPlannerConfig
 from .gain import PathGains, compute_vertex_gains, exploration_gains
 from .graph import LocalGraph, ShortestPaths, build_local_graph, shortest_paths
+from .link_loss import LinkLoss
 from .local_map import GROUND_ATTACHED, LocalMap
 from .path_improvement import improve_path, segments_admissible, truncate_path
 
@@ -122,6 +123,7 @@ class LocalPlanner:
         exploring_direction_rad: float | None = None,
         exploration_bounds: tuple[np.ndarray, np.ndarray] | None = None,
         bound: LocalBound | None = None,
+        link_loss: LinkLoss | None = None,
     ) -> LocalPlanResult:
         """One local planning iteration from ``position`` (the body centre, metres).
 
@@ -129,6 +131,8 @@ class LocalPlanner:
         penalty (None: no penalty). ``exploration_bounds``: an axis-aligned (lo, hi)
         box that vertices must lie in (e.g. the supervisor's exploration box).
         ``bound``: use this local bounding box instead of the adaptive one.
+        ``link_loss``: the gain of vertices beyond where the radio link was lost is
+        discounted (:mod:`.link_loss`).
         """
         cfg = self.config
         diag = PlanDiagnostics()
@@ -186,6 +190,8 @@ class LocalPlanner:
 
         t = time.perf_counter()
         vertex_gain, n_eval = compute_vertex_gains(grid, graph, paths, cfg, yaw_rad)
+        if link_loss is not None:
+            vertex_gain = link_loss.discount_tree(graph.vertices, paths.predecessor, vertex_gain)
         diag.gain_s = time.perf_counter() - t
         diag.num_gain_evaluations = n_eval
 

@@ -27,6 +27,7 @@ import numpy as np
 from ..occupancy import Grid
 from .config import GBPlannerConfig
 from .global_planner import GlobalPlanner, GlobalPlanResult, HomingCheck
+from .link_loss import LinkLoss
 from .local_planner import LocalPlanner, LocalPlanResult
 
 #: Modes of a :class:`PlanResult`.
@@ -75,8 +76,12 @@ class GBPlanner:
         yaw_rad: float = 0.0,
         endurance_remaining_s: float | None = None,
         exploration_bounds: tuple[np.ndarray, np.ndarray] | None = None,
+        link_loss: LinkLoss | None = None,
     ) -> PlanResult:
-        """One planning iteration (see the module docstring)."""
+        """One planning iteration (see the module docstring). With ``link_loss``, the
+        local gain beyond the points where the radio link was lost is discounted and
+        the frontiers beyond them (on the global graph, seen from home) are left out
+        of this iteration's repositioning (they are kept for later)."""
         position = np.asarray(position, float).reshape(3)
         gp = self.global_planner
         if not np.all(np.isfinite(position)):
@@ -96,17 +101,25 @@ class GBPlanner:
             direction = self.exploring_direction_rad
         local = self.local_planner.plan(
             grid, position, rng, yaw_rad=yaw_rad, exploring_direction_rad=direction,
-            exploration_bounds=exploration_bounds,
+            exploration_bounds=exploration_bounds, link_loss=link_loss,
         )
         gp.add_local_result(local, grid)
         if gp.reposition_due or local.path is None:
-            rep = gp.plan_reposition(grid, position, endurance_remaining_s)
+            hidden = {}
+            if link_loss is not None and len(link_loss.points):
+                beyond = link_loss.beyond_on_graph(gp.graph, gp.home_vertex, list(gp.frontiers), gp.position_of)
+                hidden = {v: gp.frontiers.pop(v) for v in sorted(beyond)}
+            try:
+                rep = gp.plan_reposition(grid, position, endurance_remaining_s)
+            finally:
+                gp.frontiers.update(hidden)
             if rep.ok:
                 self.exploring_direction_rad = _heading(rep.path)
                 return PlanResult(rep.path, "reposition", rep.gain, "local gain stayed low" if local.ok
                                   else f"local planner: {local.reason}", local, rep, check)
-            # No frontier left and the local gain low: the exploration is complete.
-            complete = not gp.frontiers and local.graph is not None and local.graph.num_vertices > 1
+            # No frontier left (but beyond a link loss) and the local gain low: the
+            # exploration is complete.
+            complete = not set(gp.frontiers).difference(hidden) and local.graph is not None and local.graph.num_vertices > 1
             if local.path is None or (complete and gp.reposition_due):
                 what = "exploration complete: " if complete else ""
                 reason = f"{what}local planner: {local.reason or 'low gain'}; global planner: {rep.reason}"

@@ -339,3 +339,22 @@ children:
     assert robot.path_status.value != "following"
     assert set(tick_for(root, ctx, robot, 10.0)) == {Status.FAILURE} and len(robot.paths) == 1
 
+
+# ------------------------------------------------------------------ RememberLinkLoss
+
+
+def test_the_robot_remembers_where_it_lost_the_link_once_per_place(tunnel):
+    grid, a, _ = tunnel
+    robot = FakeRobot(grid, body(a, 20.0))
+    ctx = make_ctx(robot)
+    node = build("type: RememberLinkLoss\nmerge_radius_m: 2.0", ctx)
+    node.tick_once()
+    assert node.status == Status.SUCCESS
+    (first,) = bb("link_loss_points")
+    assert first == pytest.approx(list(body(a, 20.0)), abs=0.01)
+    robot._pos = body(a, 21.0)  # the same edge again: nothing new
+    node.tick_once()
+    robot._pos = body(a, 30.0)
+    node.tick_once()
+    assert len(bb("link_loss_points")) == 2
+    assert [e["new"] for e in events(ctx, "link_loss")] == [True, False, True]
