@@ -36,9 +36,11 @@ blocks the link.
 The mesh: every robot radio and every active breadcrumb is a node; messages go
 along the route of highest success probability (networkx Dijkstra with hop weights
 ``−ln(1 − p)``), each hop failing independently. A node added with ``relay=False``
-(an aerial robot that is only a WiFi client, as in the paper) ends or starts routes
-but never forwards. A message that fails, or has no route, stays in its outbox in
-order and is tried again at the next update: nothing sent is lost.
+is a WiFi client (the paper's aerial robots, which carried no mesh radio and joined
+the nearest access point: a legged or roving robot, a breadcrumb or the base
+station): it links only to mesh nodes, never to another client, and it ends or
+starts routes but never forwards. A message that fails, or has no route, stays in
+its outbox in order and is tried again at the next update: nothing sent is lost.
 
 Breadcrumbs are static relay nodes that carrier robots drop at run time
 (:meth:`RadioNetwork.deploy_breadcrumb`); each robot carries ``breadcrumbs_per_robot``
@@ -462,6 +464,11 @@ class RadioNetwork:
         for n in sorted(self.endpoints):
             self._deliver(self.endpoints[n])
 
+    def _is_client(self, name: str) -> bool:
+        """Whether node ``name`` is a WiFi client (an endpoint added with ``relay=False``)."""
+        ep = self.endpoints.get(name)
+        return ep is not None and not ep.relay
+
     def refresh_links(self) -> None:
         """Re-evaluate every link now (``update`` does this once a period)."""
         pos = self.node_positions()
@@ -472,6 +479,8 @@ class RadioNetwork:
             pa = np.array([pos[a] for a, _ in pairs])
             pb = np.array([pos[b] for _, b in pairs])
             for (a, b), budget in zip(pairs, self._budgets(pa, pb)):
+                if self._is_client(a) and self._is_client(b):
+                    continue  # a client joins an access point, never another client
                 if budget.linked and (min(a, b), max(a, b)) not in self.cut_links:
                     self._links[(min(a, b), max(a, b))] = budget
         graph = nx.Graph()

@@ -115,7 +115,9 @@ class VoxelBackend(WorldBackend):
         base = PLATFORMS[spec.platform]
         platform = replace(base, **spec.overrides, lidar=replace(base.lidar, **spec.lidar))
         holder: dict[str, SimRobot] = {}
-        radio = self.radio.add(spec.name, lambda: holder["r"].true_position, breadcrumbs=spec.breadcrumbs)
+        # Aerial robots are WiFi clients of the mesh, not relays (CERBERUS section 3.4).
+        radio = self.radio.add(spec.name, lambda: holder["r"].true_position, breadcrumbs=spec.breadcrumbs,
+                               relay=not platform.aerial)
         robot = SimRobot(spec.name, platform, self.world, start, radio, spec.endurance_s)
         holder["r"] = robot
         return robot

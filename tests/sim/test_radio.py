@@ -274,6 +274,21 @@ def test_clients_do_not_relay(straight):
         assert net.route("drone", "base") == ["drone", "base"]
 
 
+def test_clients_link_to_mesh_nodes_only(straight):
+    """Two aerial robots (WiFi clients) side by side: each links to the mesh nodes (the
+    legged robot, the base station), not to the other: they talk through an access point."""
+    net, clock = make_net(straight, loss=0.0, fading=False)
+    net.add("base", lambda: at(2))
+    net.add("drone1", lambda: at(85), relay=False)
+    net.add("drone2", lambda: at(90), relay=False)
+    net.add("robot", lambda: at(95))
+    tick(net, clock)
+    assert not net.direct_link("drone1", "drone2")
+    assert net.direct_link("drone1", "robot") and net.direct_link("drone2", "robot")
+    route = net.route("drone2", "drone1")
+    assert len(route) == 3 and route[1] in ("robot", "base")
+
+
 def test_sim_robot_drops_breadcrumbs_on_the_ground(straight):
     net, _ = make_net(straight)
     holder = {}
