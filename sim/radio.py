@@ -43,9 +43,10 @@ starts routes but never forwards. A message that fails, or has no route, stays i
 its outbox in order and is tried again at the next update: nothing sent is lost.
 
 Breadcrumbs are static relay nodes that carrier robots drop at run time
-(:meth:`RadioNetwork.deploy_breadcrumb`); each robot carries ``breadcrumbs_per_robot``
-(4, as the paper's Carrier ANYmals) unless set otherwise, and a breadcrumb relays
-for ``breadcrumb_battery_s`` (2 h) after its drop.
+(:meth:`RadioNetwork.deploy_breadcrumb`), only where they would link to a mesh node
+(a drop out of the mesh's reach is refused, not made); each robot carries
+``breadcrumbs_per_robot`` (4, as the paper's Carrier ANYmals) unless set otherwise,
+and a breadcrumb relays for ``breadcrumb_battery_s`` (2 h) after its drop.
 
 All randomness (per-hop losses of messages and pings) comes from the rng passed in,
 drawn in a fixed order (endpoints by name, messages in outbox order, hops along the
@@ -215,7 +216,8 @@ class BreadcrumbDrop:
     """The result of asking a robot to drop a breadcrumb.
 
     ``ok`` tells whether one was dropped; then ``name`` is the new node's name.
-    Otherwise ``error`` says why not (no breadcrumbs left, position inside rock, ...).
+    Otherwise ``error`` says why not (no breadcrumbs left, position inside rock, no
+    mesh node heard there, ...).
     ``remaining`` is the owner's count after the attempt.
     """
 
@@ -352,11 +354,34 @@ class RadioNetwork:
         if not self.world.is_free(p[None])[0]:
             return BreadcrumbDrop(False, owner, None, ep.breadcrumbs,
                                   f"breadcrumb position {np.round(p, 2).tolist()} is inside rock")
+        heard, best = self.mesh_heard_at(p, owner)
+        if not heard:
+            return BreadcrumbDrop(False, owner, None, ep.breadcrumbs,
+                                  f"a breadcrumb at {np.round(p, 2).tolist()} would hear no mesh node{best}")
         ep.breadcrumbs -= 1
         ep.breadcrumbs_deployed += 1
         name = f"{owner}_breadcrumb_{ep.breadcrumbs_deployed}"
         self.breadcrumbs[name] = Breadcrumb(name, owner, p.copy(), float(self.now_s()))
         return BreadcrumbDrop(True, owner, name, ep.breadcrumbs)
+
+    def mesh_heard_at(self, position: np.ndarray, owner: str | None = None) -> tuple[bool, str]:
+        """Whether a relay at ``position`` would link to a mesh node on the air now (the
+        base station, a relaying robot or an active breadcrumb; not ``owner``, which
+        stands there, nor a client), and, when it would not, which node came closest
+        (``" (best: NAME, margin M dB)"``, or "" with no node at all)."""
+        nodes = {n: q for n, q in self.node_positions().items()
+                 if n != owner and not self._is_client(n)}
+        if not nodes:
+            return False, ""
+        names = list(nodes)
+        p = np.asarray(position, float).reshape(1, 3)
+        budgets = self._budgets(np.repeat(p, len(names), axis=0), np.array([nodes[n] for n in names]))
+        if any(b.linked for b in budgets):
+            return True, ""
+        margins = [b.margin_db if math.isfinite(b.margin_db) else -math.inf for b in budgets]
+        k = int(np.argmax(margins))
+        margin = "out of range" if not math.isfinite(margins[k]) else f"margin {margins[k]:.1f} dB"
+        return False, f" (best: {names[k]}, {margin})"
 
     def active_breadcrumbs(self) -> list[Breadcrumb]:
         """Breadcrumbs whose battery still runs (and that did not die), by name."""

@@ -2,6 +2,8 @@
 breadcrumbs."""
 from __future__ import annotations
 
+from typing import Any
+
 from py_trees.common import Status
 from py_trees.ports import PortInformation
 
@@ -57,24 +59,47 @@ class Relocate(PathMotion):
 class DeployBreadcrumb(Skill):
     """Drop a WiFi breadcrumb on the ground under the robot (Carrier ANYmals hold four).
 
-    Reads and clears ``breadcrumb_request``. Returns SUCCESS when a breadcrumb was
-    dropped; FAILURE when none is requested, or when the robot has none left or no
-    ground to drop it on (the reason in the log; never an exception).
+    Reads ``breadcrumb_request``. A drop is refused where the breadcrumb would hear no
+    mesh node, or has no ground to land on (a result with an error from the robot,
+    never an exception). Writes ``breadcrumb_request``: cleared once a breadcrumb is
+    dropped, once the robot has none left, and after ``max_attempts`` refusals in a
+    row; kept after a refusal before that, so that the tree can back the robot up
+    toward the mesh and try again. A drop also clears ``link_loss_points`` (the mesh
+    now reaches farther than where the link was lost). Logs ``breadcrumb_dropped``
+    or ``breadcrumb_failed`` (with ``gave_up`` when the request is dropped).
+    Returns SUCCESS when a breadcrumb was dropped; FAILURE when none is requested,
+    or the drop was refused.
     """
 
+    PARAMS = {"max_attempts": Param(int, 4, "refused drops in a row before the request is given up", minimum=1)}
     INPUT_PORTS = {"breadcrumb_request": PortInformation(bool, required=False,
                                                          description="True when a breadcrumb is to be dropped")}
-    OUTPUT_PORTS = {"breadcrumb_request": PortInformation(bool, description="cleared (False) when it is taken")}
+    OUTPUT_PORTS = {
+        "breadcrumb_request": PortInformation(bool, description="cleared (False) when served or given up"),
+        "link_loss_points": PortInformation(list, description="cleared ([]) by a drop"),
+    }
+
+    def __init__(self, name: str, ctx: Any, remap: dict[str, str] | None = None, **params: Any):
+        super().__init__(name, ctx, remap, **params)
+        self.refusals = 0
 
     def update(self) -> Status:
         if not self.read("breadcrumb_request"):
+            self.refusals = 0
             return Status.FAILURE
-        self.write("breadcrumb_request", False)
         drop = self.robot.deploy_breadcrumb()
         if not drop.ok:
+            self.refusals += 1
+            give_up = drop.remaining <= 0 or self.refusals >= self.p["max_attempts"]
+            if give_up:
+                self.write("breadcrumb_request", False)
+                self.refusals = 0
             self.feedback_message = drop.error
-            self.event("breadcrumb_failed", reason=drop.error)
+            self.event("breadcrumb_failed", reason=drop.error, at=xyz(self.robot.position, 2), gave_up=give_up)
             return Status.FAILURE
+        self.write("breadcrumb_request", False)
+        self.write("link_loss_points", [])
+        self.refusals = 0
         self.event("breadcrumb_dropped", trigger=True, name=drop.name, remaining=drop.remaining,
                    at=xyz(self.robot.position, 2))
         return Status.SUCCESS

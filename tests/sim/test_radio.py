@@ -274,6 +274,27 @@ def test_clients_do_not_relay(straight):
         assert net.route("drone", "base") == ["drone", "base"]
 
 
+def test_a_breadcrumb_is_dropped_only_where_it_hears_the_mesh(corner):
+    """The base station 10 m before the corner: 40 m down the second leg a breadcrumb
+    would link to nothing, so the drop is refused (a result with an error, the
+    breadcrumb kept); 5 m past the corner it links to the base and is dropped, and
+    then the far spot hears the new breadcrumb down the leg. Neither the carrier
+    itself nor a WiFi client counts as the mesh."""
+    net, clock = make_net(corner, loss=0.0, fading=False)
+    net.add("base", lambda: at(50))
+    net.add("drone", lambda: at(60, 38), relay=False)
+    carrier = net.add("carrier", lambda: at(60, 40), breadcrumbs=2)
+    tick(net, clock)
+    far = carrier.deploy_breadcrumb(at(60, 40))
+    assert not far.ok and far.remaining == 2 and carrier.breadcrumbs == 2 and net.breadcrumbs == {}
+    assert "would hear no mesh node (best: base, margin -" in far.error
+    near = carrier.deploy_breadcrumb(at(60, 5))
+    assert near.ok and near.remaining == 1
+    tick(net, clock)
+    assert net.mesh_heard_at(at(60, 40), "carrier") == (True, "")
+    assert carrier.deploy_breadcrumb(at(60, 40)).ok
+
+
 def test_clients_link_to_mesh_nodes_only(straight):
     """Two aerial robots (WiFi clients) side by side: each links to the mesh nodes (the
     legged robot, the base station), not to the other: they talk through an access point."""
@@ -291,6 +312,7 @@ def test_clients_link_to_mesh_nodes_only(straight):
 
 def test_sim_robot_drops_breadcrumbs_on_the_ground(straight):
     net, _ = make_net(straight)
+    net.add("base", lambda: at(2))
     holder = {}
     radio = net.add("anymal", lambda: holder["r"].position)
     robot = SimRobot("anymal", LEGGED, straight, np.array([30.0, 0.0, 0.0]), radio)

@@ -147,5 +147,5 @@ def test_cops_behaviours_that_only_read_the_state_do_not_store_one():
 
 def test_a_key_read_and_written_is_registered_once_for_write():
     node = build(SKILLS["DeployBreadcrumb"])
-    assert node.bb.write == {"/r1/breadcrumb_request"} and not node.bb.read
+    assert node.bb.write == {"/r1/breadcrumb_request", "/r1/link_loss_points"} and not node.bb.read
     assert "breadcrumb_request" in node.INPUT_PORTS and "breadcrumb_request" in node.OUTPUT_PORTS

@@ -188,20 +188,59 @@ def test_a_requested_breadcrumb_is_dropped_once(half_mapped):
     assert drop.status == Status.FAILURE and robot.breadcrumbs == 3  # one request, one breadcrumb
 
 
-@pytest.mark.parametrize("breadcrumbs, ground, reason", [(0, True, "no breadcrumbs left"),
-                                                          (2, False, "no ground")])
-def test_a_refused_drop_is_a_failure_with_its_reason(half_mapped, breadcrumbs, ground, reason):
+def test_a_drop_refused_with_none_left_gives_the_request_up(half_mapped):
     grid, a, _ = half_mapped
-    robot = FakeRobot(grid, body(a, 8.0), breadcrumbs=breadcrumbs)
-    robot.has_ground = ground
+    robot = FakeRobot(grid, body(a, 8.0), breadcrumbs=0)
     ctx = make_ctx(robot)
     drop = build("type: DeployBreadcrumb", ctx)
     py_trees.blackboard.Blackboard.set("/r1/breadcrumb_request", True)
     drop.tick_once()
     assert drop.status == Status.FAILURE
-    assert reason in events(ctx, "breadcrumb_failed")[0]["reason"]
+    (failed,) = events(ctx, "breadcrumb_failed")
+    assert "no breadcrumbs left" in failed["reason"] and failed["gave_up"] is True
     assert bb("breadcrumb_request") is False  # not tried again on every tick
-    assert robot.breadcrumbs == breadcrumbs and not events(ctx, "breadcrumb_dropped")
+    assert not events(ctx, "breadcrumb_dropped")
+
+
+def test_a_refused_drop_keeps_the_request_for_a_few_more_attempts(half_mapped):
+    """A spot that does not take a breadcrumb (no mesh heard, no ground): the request
+    stays for the tree to try elsewhere, up to max_attempts refusals in a row."""
+    grid, a, _ = half_mapped
+    robot = FakeRobot(grid, body(a, 8.0), breadcrumbs=2)
+    robot.has_ground = False
+    ctx = make_ctx(robot)
+    drop = build("type: DeployBreadcrumb\nmax_attempts: 3", ctx)
+    py_trees.blackboard.Blackboard.set("/r1/breadcrumb_request", True)
+    for _ in range(3):
+        drop.tick_once()
+        assert drop.status == Status.FAILURE
+    assert [e["gave_up"] for e in events(ctx, "breadcrumb_failed")] == [False, False, True]
+    assert bb("breadcrumb_request") is False and robot.breadcrumbs == 2
+
+
+def test_a_refused_drop_backs_the_robot_up_and_drops_there(half_mapped):
+    """trees/subtrees/breadcrumbs.yaml: refused where the robot stands, the robot backs
+    up along its path and drops the breadcrumb where the drop is accepted."""
+    grid, a, _ = half_mapped
+    trail = [body(a, x) for x in np.arange(2.0, 12.01, 0.5)]
+    robot = FakeRobot(grid, trail[-1], breadcrumbs=2, trail=trail)
+    robot.has_ground = False
+    ctx = make_ctx(robot)
+    root = build("include: subtrees/breadcrumbs.yaml", ctx)
+    py_trees.blackboard.Blackboard.set("/r1/breadcrumb_request", True)
+    py_trees.blackboard.Blackboard.set("/r1/link_loss_points", [[30.0, 0.0, 1.0]])
+    root.tick_once()
+    assert root.status == Status.RUNNING and events(ctx, "backtrack")  # refused: backing up
+    for _ in range(2):
+        robot.step(1.0)
+        ctx.clock.now_s += 1.0
+        root.tick_once()
+    robot.has_ground = True  # the spot 3 m back takes it
+    assert run(root, ctx, robot) == Status.FAILURE  # the block is done: lower blocks run
+    root.tick_once()
+    assert len(robot.drops) == 1 and robot.breadcrumbs == 1 and bb("breadcrumb_request") is False
+    assert np.linalg.norm(robot.drops[0] - body(a, 9.0)) < 0.2
+    assert bb("link_loss_points") == []
 
 
 def test_the_supervisors_drop_command_drops_a_breadcrumb(half_mapped):
