@@ -31,8 +31,10 @@ from typing import Any, ClassVar
 
 import numpy as np
 from py_trees.common import Status
+from py_trees.ports import PortInformation
 
 from ..planners.geometry import path_length, xyz
+from ..planners.unseen_wall import unseen_wall
 from ..planners.visibility import BodyCameras, line_of_sight
 from .base import AgentContext, Param, ParamNamedPort, Skill
 from .inspection import (
@@ -147,6 +149,60 @@ class LookWithBodyCameras(Skill):
         if now + 1e-9 >= record.next_update_s:
             record.look(r, self.cameras)
             record.next_update_s = now + self.p["body_camera_period_s"]
+        return Status.SUCCESS
+
+
+class NoticeUnseenWall(Skill):
+    """The exploration planner's inspection request: wall of the onboard map within
+    ``radius_m`` that no camera has covered (the body cameras' and payload's record)
+    and that the robot sees from where it stands.
+
+    Cheap and rate-limited: looks at most every ``check_period_s``, only in mode
+    ``when_mode`` (null: any), only when the robot carries a payload and no request is
+    pending, and not within ``min_spacing_m`` of where it last asked. When the unseen
+    wall is at least ``min_unseen_area_m2`` and ``min_unseen_fraction`` of the wall
+    within reach, writes ``request_key`` (``{point: null, requested_s, source:
+    planner}``: scan the area, as the supervisor's ``scan``) and logs
+    ``inspection_requested`` (trigger). Always SUCCESS (the inspection steps that
+    follow take the request up).
+    """
+
+    PARAMS: ClassVar[dict[str, Param]] = {
+        "request_key": Param(str, "inspection_request", "blackboard key of the request", key=True),
+        "check_period_s": Param(float, 10.0, "how often the unseen wall is measured", exclusive_minimum=0),
+        "radius_m": Param(float, 5.0, "wall within this distance counts", exclusive_minimum=0),
+        "min_unseen_area_m2": Param(float, 6.0, "unseen wall that calls for a scan", minimum=0),
+        "min_unseen_fraction": Param(float, 0.3, "... and its least share of the wall within reach",
+                                     minimum=0, maximum=1),
+        "min_spacing_m": Param(float, 10.0, "no new request this close to where the last was made", minimum=0),
+        "when_mode": Param(str, "explore", "the mode the robot must be in (null: any)", nullable=True),
+    }
+    INPUT_PORTS = {"inspection_request": REQUEST_IN,
+                   "mode": PortInformation(str, required=False, description="the mode of operation")}
+    OUTPUT_PORTS = {"inspection_request": ParamNamedPort(dict | None, description="the planner's request",
+                                                         key_param="request_key")}
+
+    def __init__(self, name: str, ctx: AgentContext, remap: dict[str, str] | None = None, **params: Any):
+        super().__init__(name, ctx, remap, **params)
+        self.next_check_s = -math.inf
+        self.last_at: np.ndarray | None = None
+
+    def update(self) -> Status:
+        r, now, p = self.robot, self.ctx.clock.now_s, self.p
+        if now + 1e-9 < self.next_check_s or r.payload is None or self.read("inspection_request"):
+            return Status.SUCCESS
+        if p["when_mode"] is not None and self.read("mode") != p["when_mode"]:
+            return Status.SUCCESS
+        if self.last_at is not None and np.linalg.norm(r.position - self.last_at) < p["min_spacing_m"]:
+            return Status.SUCCESS
+        self.next_check_s = now + p["check_period_s"]
+        eye = r.payload.camera_position(body_pose(r))
+        wall = unseen_wall(r.onboard_map, eye, p["radius_m"], seen_record(self.ctx, r).seen)
+        if wall.area_m2 >= p["min_unseen_area_m2"] and wall.fraction >= p["min_unseen_fraction"]:
+            self.last_at = r.position
+            self.write("inspection_request", {"point": None, "requested_s": round(now, 3), "source": "planner"})
+            self.event("inspection_requested", trigger=True, source="planner", unseen_area_m2=round(wall.area_m2, 1),
+                       unseen_fraction=round(wall.fraction, 3), centroid=xyz(wall.centroid))
         return Status.SUCCESS
 
 
@@ -647,5 +703,5 @@ class ReportInspectionFailure(_Report):
 
 
 __all__ = ["STATE_SERVICE", "ApproachInspectionPoint", "ChooseScanPoints", "InspectionJob", "InspectionState",
-           "InspectionStep", "LookWithBodyCameras", "ReportInspection", "ReportInspectionFailure",
+           "InspectionStep", "LookWithBodyCameras", "NoticeUnseenWall", "ReportInspection", "ReportInspectionFailure",
            "ResumeInterruptedPath", "ScanWithPayload", "TakeInspectionRequest", "inspection_state"]

@@ -391,3 +391,68 @@ def test_a_point_out_of_reach_is_walked_to_then_the_same_path_resumed(tunnel):
     assert np.allclose(np.asarray(resume["path"])[-len(left):], left, atol=1e-3)
     assert np.allclose(robot.position, path[-1])                      # and went on to its end
     assert read("inspection_result")["covered_fraction"] > 0.9
+
+
+def mode(value: str) -> None:
+    py_trees.blackboard.Blackboard.set("/r1/mode", value)
+
+
+def test_the_robot_requests_a_scan_where_its_map_shows_unseen_wall(tunnel):
+    """NoticeUnseenWall in the inspections subtree: exploring beside wall no camera has
+    covered, the robot asks for an area scan (the supervisor's scan, from the planner),
+    at most every check period and not again within min_spacing_m."""
+    grid, start, _ = tunnel
+    robot = camera_robot(grid, body(start, 4))
+    ctx = make_ctx(robot)
+    notice = build_tree({"type": "NoticeUnseenWall", "check_period_s": 10.0, "min_spacing_m": 6.0}, ctx)
+    notice.tick_once()
+    assert notice.status == Status.SUCCESS and read("inspection_request") is None  # not exploring
+    mode("explore")
+    notice.tick_once()
+    asked = read("inspection_request")
+    assert asked == {"point": None, "requested_s": 0.0, "source": "planner"}
+    (logged,) = events(ctx, "inspection_requested")
+    assert logged["trigger"] and logged["unseen_area_m2"] >= 6.0 and logged["unseen_fraction"] >= 0.3
+    py_trees.blackboard.Blackboard.set("/r1/inspection_request", None)  # the inspection took it
+    robot._pos = body(start, 8)  # 4 m on: too close to the last request
+    ctx.clock.now_s = 20.0
+    notice.tick_once()
+    assert read("inspection_request") is None
+    robot._pos = body(start, 12)  # 8 m on: asks again
+    ctx.clock.now_s = 25.0
+    notice.tick_once()
+    assert read("inspection_request") is not None and len(events(ctx, "inspection_requested")) == 2
+    py_trees.blackboard.Blackboard.set("/r1/inspection_request", None)
+    robot._pos = body(start, 20)  # far enough, but within the check period of that look
+    ctx.clock.now_s = 30.0
+    notice.tick_once()
+    assert read("inspection_request") is None
+
+
+def test_no_scan_is_requested_where_the_cameras_have_seen_the_wall_or_without_a_payload(tunnel):
+    grid, start, _ = tunnel
+    mode("explore")
+    for payload in (True, False):
+        robot = camera_robot(grid, body(start, 4), payload=payload)
+        ctx = make_ctx(robot)
+        if payload:
+            ctx.services[SEEN_SERVICE] = SeenRecord(np.ones(grid.occupancy.shape, bool))  # all seen
+        build_tree({"type": "NoticeUnseenWall"}, ctx).tick_once()
+        assert read("inspection_request") is None and not events(ctx, "inspection_requested")
+
+
+def test_a_planner_request_runs_the_same_inspection(tunnel):
+    grid, start, _ = tunnel
+    robot = camera_robot(grid, body(start, 4))
+    ctx = make_ctx(robot)
+    mode("explore")
+    root = load_tree(TREES / "subtrees" / "inspections.yaml", ctx)
+    root.tick_once()
+    assert root.status == Status.RUNNING  # the request was taken up at once
+    assert events(ctx, "inspection_requested") and events(ctx, "inspection_start")
+    for _ in range(2000):
+        if step(root, ctx, robot) != Status.RUNNING:
+            break
+    assert root.status == Status.FAILURE  # done: lower blocks run
+    (done,) = events(ctx, "inspection_done")
+    assert done["scans_taken"] >= 1 and read("inspection_request") is None
