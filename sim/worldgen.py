@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .limits import DEFAULT_VOXEL_SIZE_M, check_total_length, check_voxels
+from .limits import DEFAULT_VOXEL_SIZE_M, MAX_TOTAL_LENGTH_M, check_total_length, check_voxels
 from .meshio import from_mesh, write_scan_mesh
 from .world import World
 from .worldgen_cave import (CAVE_FLOOR_BAND_M, CavePlan, add_cave_branches, add_cave_upper,
@@ -291,7 +291,9 @@ def subt_final(seed: int, *, scale: float = 1.0, tunnel_length_m: float = 700.0,
     if not CAVE_HEIGHT_M[1] <= ch <= CAVERN_MAX_M:
         raise ValueError(f"cavern_height_m must lie in [{CAVE_HEIGHT_M[1]:g}, {CAVERN_MAX_M:g}], "
                          f"got {ch:g}")
-    check_total_length(sum(lengths.values()))
+    if sum(lengths.values()) > MAX_TOTAL_LENGTH_M:
+        raise ValueError(f"scale: the sections add up to {sum(lengths.values()):g} m, more than "
+                         f"{MAX_TOTAL_LENGTH_M:g} m, the longest world delve generates")
     return build_course(seed, lengths, entrance, stairs, cw, ch, v, name)
 
 

@@ -49,9 +49,12 @@ DRIFT_SPACING_M = 20.0
 DRIFT_STATION_M = 15.0
 DRIFT_WIDTH_M = (3.5, 4.5)
 DRIFT_HEIGHT_M = (3.5, 4.5)
-#: Stations wander this far across the drift (m) and the floor this far up or down.
+#: Stations wander this far across the drift (m) and the floor this far up or down,
+#: by steps of about DRIFT_GRADE_STEP_M (grades of 1-3 %, so that drifts meeting at a
+#: junction leave no step in its floor).
 DRIFT_JITTER_M = 1.5
-DRIFT_GRADE_M = 1.0
+DRIFT_GRADE_M = 0.5
+DRIFT_GRADE_STEP_M = 0.2
 #: A crosscut joins neighbouring drifts at every this many stations.
 CROSSCUT_EVERY = 4
 #: Side cuts: length range (m, fits between two drifts) and largest angle off square.
@@ -92,10 +95,15 @@ def plan_entrance_and_hall(plan: CoursePlan, slope_deg: float, v: float) -> dict
     turn = plan.add_node([-hx - ENTRANCE_LEG_M, 0.0, 0.0], "entrance")
     down = -math.radians(ENTRANCE_TURN_DEG)           # heading down the incline
     rise = snap_height(ENTRANCE_RUN_M * math.tan(math.radians(slope_deg)), v)
-    portal = plan.pos[turn] - [ENTRANCE_RUN_M * math.cos(down), ENTRANCE_RUN_M * math.sin(down), -rise]
-    ids["portal"] = plan.add_node(portal, "entrance")
     s = ENTRANCE_SIZE_M
-    plan.join(ids["portal"], turn, s, s, "ramp", "entrance", "tunnel")
+    heading = np.array([math.cos(down), math.sin(down), 0.0])
+    # a flat landing of one drift width between the incline and the turn, so that the
+    # drift on from the turn does not undercut the incline's floor
+    foot = plan.add_node(plan.pos[turn] - s * heading, "entrance")
+    ids["portal"] = plan.add_node(plan.pos[foot] - ENTRANCE_RUN_M * heading + [0.0, 0.0, rise],
+                                  "entrance")
+    plan.join(ids["portal"], foot, s, s, "ramp", "entrance", "tunnel")
+    plan.join(foot, turn, s, s, "tunnel", "entrance", "tunnel")
     plan.join(turn, ids["west"], s, s, "tunnel", "entrance", "tunnel")
     return ids
 
@@ -119,7 +127,7 @@ class TunnelSection:
             row, z = [], 0.0
             for i in range(self.m):
                 dy = float(rng.uniform(-DRIFT_JITTER_M, DRIFT_JITTER_M)) if i else 0.0
-                z = 0.0 if i == 0 else snap_height(float(np.clip(z + rng.normal(0.0, 0.4),
+                z = 0.0 if i == 0 else snap_height(float(np.clip(z + rng.normal(0.0, DRIFT_GRADE_STEP_M),
                                                                  -DRIFT_GRADE_M, DRIFT_GRADE_M)), v)
                 row.append(plan.add_node([x0 + i * DRIFT_STATION_M, y + dy, z], "tunnel"))
             for a, b in zip(row, row[1:]):

@@ -133,14 +133,16 @@ class CoursePlan:
         """Round chambers (radius, height, climbing passages) at every mine-drift node
         (junctions, bends and rounded dead ends, as in worldgen.tunnel_network)."""
         drifts: dict[int, list[Passage]] = {}
+        meeting: dict[int, list[Passage]] = {}
         for p in self.passages:
-            if p.shape == "tunnel":
-                drifts.setdefault(p.a, []).append(p)
-                drifts.setdefault(p.b, []).append(p)
+            for n in (p.a, p.b):
+                meeting.setdefault(n, []).append(p)
+                if p.shape == "tunnel":
+                    drifts.setdefault(n, []).append(p)
         out = {}
         for n, ps in sorted(drifts.items()):
             upward = []
-            for p in ps:
+            for p in meeting[n]:         # the floor rises with every passage that climbs away
                 d = self.pos[p.b if p.a == n else p.a] - self.pos[n]
                 run = float(np.hypot(d[0], d[1]))
                 if d[2] > 0 and run > 1e-9:
