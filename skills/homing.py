@@ -195,16 +195,22 @@ class EndSortie(Skill):
 
     The CERBERUS supervisor sent robots on short budgeted sorties and re-tasked them
     when they came back, so homing ends a sortie; it ends the mission when the
-    supervisor called the robot home, or when no supervisor ever tasked it.
-    Reads ``end_at_home`` (written by ProcessOperatorCommands; True when unset).
-    Returns SUCCESS when it is True (the mission is over). Otherwise writes ``mode``
+    supervisor called the robot home, when no supervisor ever tasked it, or when
+    GBPlanner2 sent it home because its endurance barely covered the way.
+    Reads ``end_at_home`` (written by ProcessOperatorCommands; True when unset) and
+    ``homing_due`` (written by ExploreGBPlanner2). Returns SUCCESS when either is
+    True (the mission is over). Otherwise writes ``mode``
     idle and clears ``time_budget_s`` and ``budget_start_s``, logs ``sortie_ended``
     and returns FAILURE, so that the tree's lower blocks run (the last one waits for
     the next command).
     """
 
-    INPUT_PORTS = {"end_at_home": PortInformation(bool, required=False, default_value=True,
-                                                  description="True: homing ends the mission")}
+    INPUT_PORTS = {
+        "end_at_home": PortInformation(bool, required=False, default_value=True,
+                                       description="True: homing ends the mission"),
+        "homing_due": PortInformation(bool, required=False, default_value=False,
+                                      description="True: the endurance called the robot home"),
+    }
     OUTPUT_PORTS = {
         "mode": PortInformation(str, description="``idle`` after a sortie"),
         "time_budget_s": PortInformation(float | None, description="cleared after a sortie"),
@@ -212,7 +218,7 @@ class EndSortie(Skill):
     }
 
     def update(self) -> Status:
-        if self.read("end_at_home", True):
+        if self.read("end_at_home", True) or self.read("homing_due", False):
             self.feedback_message = "home: the mission is over"
             return Status.SUCCESS
         self.write("mode", "idle")

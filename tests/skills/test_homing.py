@@ -305,3 +305,6 @@ def test_end_sortie_ends_the_mission_unless_the_supervisor_will_send_the_robot_o
     assert end.status == Status.FAILURE  # a sortie ended: lower blocks run, the last waits
     assert (bb("mode"), bb("time_budget_s"), bb("budget_start_s")) == ("idle", None, None)
     assert len(events(ctx, "sortie_ended")) == 1
+    py_trees.blackboard.Blackboard.set("/r1/homing_due", True)  # the endurance called it home
+    end.tick_once()
+    assert end.status == Status.SUCCESS
