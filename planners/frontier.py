@@ -71,8 +71,6 @@ def frontier_voxels(grid: Grid, among: np.ndarray | None = None, depth: int = FR
 #: Viewpoints tried per frontier voxel for a line of sight, spread from the nearest
 #: to the farthest of those whose elevation the sensor covers (bounds the work).
 SIGHT_TRIES = 6
-
-
 #: A goal node, and a viewpoint that counts, is at most this far from its frontier (m).
 MAX_GOAL_OFFSET_M = 12.0
 #: Goal and viewpoint candidates are thinned to one node per cell of this size (m).
@@ -102,8 +100,8 @@ def in_view(sensor: np.ndarray, points: np.ndarray, view_up_deg: float, slack_m:
 
 def clear_sight(grid: Grid, a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Whether each segment ``a[i]``-``b[i]`` crosses no OCCUPIED voxel of the map and
-    stays inside it (sampled every half voxel, the end voxel excluded). Unknown voxels
-    do not block: the space between a viewpoint and a frontier is often unseen air."""
+    stays inside it (sampled every half voxel up to its end). Unknown voxels do not
+    block: the space between a viewpoint and a frontier is often unseen air."""
     step = 0.5 * grid.voxel_size_m
     length = np.linalg.norm(b - a, axis=1)
     n = np.maximum(np.ceil(length / step).astype(np.int64), 1)
@@ -247,9 +245,8 @@ def nearest_frontier(
     offset = np.linalg.norm(centroids[owner] - graph.positions[cand], axis=1)
     samples = [_view_samples(c) for c in clusters]
     sensor = graph.positions[cand] + np.array([0.0, 0.0, sensor_height_m])
-    frac = np.array([in_view(np.broadcast_to(s, samples[o].shape), samples[o], view_up_deg, 0.5 * node_spacing_m).mean()
-                     for s, o in zip(sensor, owner)]) if len(cand) else np.zeros(0)
-    cost = np.where(frac >= view_fraction, distances[cand] + offset_weight * offset, np.inf)
+    cost = np.where(_view_fractions(sensor, owner, samples, view_up_deg, 0.5 * node_spacing_m) >= view_fraction,
+                    distances[cand] + offset_weight * offset, np.inf)
     for k in np.argsort(cost, kind="stable")[:SIGHT_CANDIDATES]:
         if not np.isfinite(cost[k]):
             return None
@@ -263,6 +260,19 @@ def nearest_frontier(
         return FrontierGoal(cluster=clusters[owner[k]], node=node, path_length_m=float(distances[node]),
                             offset_m=float(offset[k]))
     return None
+
+
+def _view_fractions(sensor: np.ndarray, owner: np.ndarray, samples: list[np.ndarray], view_up_deg: float,
+                    slack_m: float) -> np.ndarray:
+    """For each sensor position, the fraction of its cluster's (``owner``) sample
+    points within ``view_up_deg`` above it (:func:`in_view`), all pairs at once."""
+    sizes = np.array([len(p) for p in samples])
+    first = np.cumsum(sizes) - sizes
+    flat = np.concatenate(samples)
+    pair = np.repeat(np.arange(len(owner)), sizes[owner])
+    point = np.arange(len(pair)) - np.repeat(np.cumsum(sizes[owner]) - sizes[owner], sizes[owner])
+    seen = in_view(sensor[pair], flat[first[owner][pair] + point], view_up_deg, slack_m)
+    return np.bincount(pair, weights=seen, minlength=len(owner)) / sizes[owner]
 
 
 def _view_samples(cluster: FrontierCluster) -> np.ndarray:
