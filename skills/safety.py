@@ -9,6 +9,7 @@ import numpy as np
 from py_trees.common import Status
 from py_trees.ports import PortInformation
 
+from ..planners.gbplanner2.link_loss import near_points
 from ..planners.geometry import xyz
 from .base import Param, Skill
 from .robot import PathStatus
@@ -139,7 +140,7 @@ class RememberLinkLoss(Skill):
     def update(self) -> Status:
         points = list(self.read("link_loss_points") or [])
         here = self.robot.position
-        known = any(np.linalg.norm(here - np.asarray(p, float)) <= self.p["merge_radius_m"] for p in points)
+        known = bool(near_points(here, np.asarray(points, float), self.p["merge_radius_m"]).any())
         if not known:
             points.append(xyz(here, 2))
             self.write("link_loss_points", points)
