@@ -20,7 +20,7 @@ from ...skills.base import Param
 from ...skills.cops import CopsSkill, CopsState
 from ..worlds import BASE
 from .base import TeamStrategy
-from .cops_report import cops_figures, declared_lost, home_by_endurance, solve_time_figures
+from .cops_report import cops_figures, declared_lost, gone_home, solve_time_figures
 
 if TYPE_CHECKING:
     from ..agent import Agent
@@ -34,8 +34,8 @@ def _cops_skill(root: Any) -> CopsSkill | None:
 
 class Cops(TeamStrategy):
     """The COPS plug-in. Report: locations known and explored at the base station,
-    robots the final plan could not reach, robots declared lost, robots that went
-    home by endurance, and every plan."""
+    robots the final plan could not reach, robots declared lost, robots that left
+    the plan for home, and every plan."""
 
     PARAMS = {"cell_m": Param(float, DEFAULT_CELL_M, "size of a location where the world is cut into "
                                                      "locations (voxel worlds' lattice cell), metres",
@@ -116,7 +116,7 @@ class Cops(TeamStrategy):
                 "locations_explored_at_base": len(topology.explored) if topology else 0,
                 "stranded_robots": self.stranded(),
                 "declared_lost": declared_lost(mission.state.events),
-                "home_by_endurance": home_by_endurance(mission.state.events),
+                "gone_home": gone_home(mission.state.events),
                 "cops": cops_figures(mission.state.events)}
 
     def wall_clock_figures(self, mission: "Mission") -> dict[str, Any]:

@@ -34,9 +34,12 @@ def transition_failures(events: list[dict[str, Any]]) -> list[dict[str, Any]]:
             for e in events if e["event"] == "cops_transition_failed"]
 
 
-def home_by_endurance(events: list[dict[str, Any]]) -> list[str]:
-    """Robots that left the plan for home because their endurance barely covered the way."""
-    return sorted({e["agent"] for e in events if e["event"] == "cops_home_by_endurance"})
+def gone_home(events: list[dict[str, Any]]) -> dict[str, list[str]]:
+    """Robots that left the plan for home: ``by_endurance`` (their endurance barely
+    covered the way), ``after_failed_move`` (a move of the plan failed)."""
+    left = [e for e in events if e["event"] == "cops_left_plan"]
+    return {"by_endurance": sorted({e["agent"] for e in left if e["reason"] == "endurance"}),
+            "after_failed_move": sorted({e["agent"] for e in left if e["reason"] != "endurance"})}
 
 
 def declared_lost(events: list[dict[str, Any]]) -> list[str]:

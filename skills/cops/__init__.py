@@ -16,9 +16,11 @@ Behaviours, in the paper's words, by module:
   ``WaitToReceivePlan``, ``ReturnWithoutPlan`` and ``MissionComplete?``.
 * :mod:`.motion`: ``TransitionAction`` and ``ActionTimer``, ``ExplorationAction``
   (Algorithm 1), ``ExplorationTimer``, ``TransitToReturnNode``.
-* :mod:`.conditions`: ``Explore?`` (``IsExploring``) and ``FinishedPlan?``.
+* :mod:`.conditions`: ``Explore?`` (``IsExploring``), ``FinishedPlan?`` and
+  ``TransitionFailed?``.
 * :mod:`.endurance`: ``LeavePlan``, ``TransitToBase`` and ``GreetBase``, a
-  robot's way home by endurance (after the onboard ``EnduranceLow``).
+  robot's way home when its endurance barely covers it (the onboard
+  ``EnduranceLow``) or a move of the plan failed.
 
 :mod:`.state` holds the state and the message ids, :mod:`.base` the behaviours'
 common base, :mod:`.voxel_view` the network a robot's voxel map reveals.
@@ -27,7 +29,7 @@ from __future__ import annotations
 
 from .base import STATE_KEY, CopsSkill, network_view
 from .communication import CommunicationAction, InformationStorage
-from .conditions import FinishedPlan, IsExploring
+from .conditions import FinishedPlan, IsExploring, TransitionFailed
 from .endurance import GreetBase, LeavePlan, TransitToBase
 from .leader import IsLeader, MissionComplete, ReturnWithoutPlan, SolveCOPS, WaitToReceivePlan
 from .motion import (ActionTimer, ExplorationAction, ExplorationTimer, TransitionAction, TransitToReturnNode,
@@ -38,6 +40,6 @@ __all__ = [
     "KIND", "PARTS", "STATE_KEY", "ActionTimer", "CommunicationAction", "CopsSkill", "CopsState",
     "ExplorationAction", "ExplorationTimer", "FinishedPlan", "GreetBase", "InformationStorage", "IsExploring",
     "IsLeader", "Knowledge", "LeavePlan", "MissionComplete", "ReturnWithoutPlan", "SolveCOPS", "TransitToBase",
-    "TransitToReturnNode", "TransitionAction", "WaitToReceivePlan", "collect_own_map", "final_plan_id",
+    "TransitToReturnNode", "TransitionAction", "TransitionFailed", "WaitToReceivePlan", "collect_own_map", "final_plan_id",
     "message_id", "network_view", "ordered_choices",
 ]

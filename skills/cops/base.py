@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
+import numpy as np
 from py_trees.common import Status
 
 from ...planners.cops.topology import Topology
@@ -79,17 +80,20 @@ class CopsSkill(Skill):
         the ``reason``). A route that ends short of ``there`` (a voxel map's graph
         reaches further as the robot walks) is asked for again where it ends. A name
         the view knows under another (a lattice cell merged into a region, see
-        :func:`view_name`) is driven to under the view's name."""
+        :func:`view_name`) is driven to under the view's name; one it does not know
+        yet, to the position the agent's knowledge gives (:meth:`_hint`)."""
         view, robot = network_view(self.ctx), self.robot
         there = view_name(view, there, self.state.knowledge.topology)
-        inside = view.location() == there
+        hint = self._hint(view, there)
+        at_hint = hint is not None and view.near(hint)
+        inside = view.location() == there or at_hint
         on_own_route = self._driving == there and getattr(self, "_command_id", None) == robot.command_id
         if inside and (not arrive or not (on_own_route and robot.path_status == PathStatus.FOLLOWING)
-                       and (self._settled == there or view.arrived(there))):
+                       and (self._settled == there or at_hint or view.arrived(there))):
             self._driving = None
             return None
         if not on_own_route or robot.path_status in (PathStatus.ARRIVED, PathStatus.IDLE):
-            route = view.route(there)
+            route = view.route(there) if hint is None else view.route_towards(hint)
             if route is None and inside:  # as near as it gets
                 self._driving, self._settled = None, there
                 return None
@@ -101,6 +105,15 @@ class CopsSkill(Skill):
             reason = f"blocked on the way to {there}"
             return self._failed(view, there, f"{reason}: {robot.blocked_reason}" if robot.blocked_reason else reason)
         return Status.RUNNING
+
+    def _hint(self, view: NetworkView, there: str) -> np.ndarray | None:
+        """Where the agent's knowledge puts a location that the robot's own map does
+        not show yet (another robot explored it), for a view that can route towards a
+        point (``resolve``, ``route_towards``, ``near``); else None."""
+        known = self.state.knowledge.topology.locations.get(there)
+        if known is None or not hasattr(view, "route_towards") or view.resolve(there) is not None:
+            return None
+        return np.asarray(known, dtype=float)
 
     def _failed(self, view: NetworkView, there: str, reason: str) -> Status:
         """FAILURE of a drive, with its reason as feedback and as an event."""

@@ -27,3 +27,15 @@ class FinishedPlan(_PartCheck):
 
     TYPE_NAME = "FinishedPlan?"
     PART = "done"
+
+
+class TransitionFailed(CopsSkill):
+    """TransitionFailed?: SUCCESS when a move of the plan failed (the Transition
+    Action or the transit to the return node found no way), else FAILURE. Reads
+    ``cops``."""
+
+    TYPE_NAME = "TransitionFailed?"
+    OUTPUT_PORTS = {}  # reads the state only
+
+    def update(self) -> Status:
+        return Status.SUCCESS if self.state.transition_failed else Status.FAILURE

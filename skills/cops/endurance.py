@@ -1,7 +1,8 @@
-"""Home by endurance: a COPS robot whose endurance barely covers the way home (the
-onboard ``EnduranceLow`` check of every robot) leaves the plan (``LeavePlan``), goes
-to the base location (``TransitToBase``; ``Home`` where the network has no route)
-and tells the base station there (``GreetBase``)."""
+"""Leaving the plan for home: a COPS robot whose endurance barely covers the way home
+(the onboard ``EnduranceLow`` check of every robot), or that could not make a move
+of the plan (``TransitionFailed?``), leaves the plan (``LeavePlan``), goes to the
+base location (``TransitToBase``; ``Home`` where the network has no route) and tells
+the base station there (``GreetBase``)."""
 from __future__ import annotations
 
 import math
@@ -13,20 +14,22 @@ from .base import CopsSkill, network_view
 
 
 class LeavePlan(CopsSkill):
-    """Leave the plan for home: mark the robot home by endurance in its knowledge
-    (``home_by_endurance``, carried with its information: partners stop waiting for
-    its messages, and the base station plans without it) and stop its motion.
+    """Leave the plan for home: mark the robot gone home in its knowledge
+    (``gone_home``, carried with its information: partners stop waiting for its
+    messages, and the base station plans without it) and stop its motion.
 
-    Reads/writes ``cops``. Logs ``cops_home_by_endurance`` (cycle, part, step, the
-    location it leaves from). Returns SUCCESS.
+    Reads/writes ``cops``. Logs ``cops_left_plan`` (cycle, part, step, the location
+    it leaves from, and the ``reason``: ``endurance``, or ``transition failed: ...``
+    when a move of the plan failed). Returns SUCCESS.
     """
 
     def update(self) -> Status:
         st = self.state
-        st.knowledge.home_by_endurance[self.ctx.name] = self.ctx.clock.now_s
+        st.knowledge.gone_home[self.ctx.name] = self.ctx.clock.now_s
         view = network_view(self.ctx)
-        self.event("cops_home_by_endurance", cycle=st.cycle, part=st.part, step=st.step,
-                   at=view.location() if view is not None else None)
+        reason = f"transition failed: {st.transition_failed}" if st.transition_failed else "endurance"
+        self.event("cops_left_plan", cycle=st.cycle, part=st.part, step=st.step,
+                   at=view.location() if view is not None else None, reason=reason)
         if self.ctx.robot is not None:
             self.robot.stop()
         return Status.SUCCESS

@@ -34,7 +34,7 @@ class SolveCOPS(CopsSkill):
     """COPS: plan the next cycle at the leader (the base station).
 
     From everything the leader knows it builds the network N (explored locations),
-    places the team (robots not declared lost nor gone home by endurance, where the
+    places the team (robots not declared lost nor gone home, where the
     last plan left them) and plans pre-exploration, exploration and
     post-exploration (``plan_cycle``). Robots whose earlier information never
     reached the base are added to the post-exploration sources. With no frontier
@@ -346,7 +346,7 @@ class MissionComplete(CopsSkill):
         team = self.ctx.services["team"]
         kn = st.knowledge
         away = [r for r in sorted(team) if final_plan_id(st.cycle, r) not in kn.acked
-                and r not in kn.home_by_endurance]
+                and r not in kn.gone_home]
         if away and now - st.planned_s > st.recall_after_s + st.lost_timeout_s:
             for r in away:
                 kn.declared[r] = now

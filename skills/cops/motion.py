@@ -23,7 +23,8 @@ class TransitionAction(CopsSkill):
 
     Reads/writes ``cops``; drives the robot through its NetworkView's routes.
     Returns RUNNING while moving, SUCCESS on arrival (at once for a stay), FAILURE
-    when the location cannot be reached.
+    when the location cannot be reached (its reason kept in ``cops``,
+    ``transition_failed``).
     """
 
     def initialise(self) -> None:
@@ -37,6 +38,8 @@ class TransitionAction(CopsSkill):
         last = st.step >= plan.horizon
         moving = self.drive_to(plan.location(self.ctx.name, min(st.step + 1, plan.horizon)), arrive=True) \
             if self.ctx.robot is not None else None
+        if moving == Status.FAILURE:
+            st.transition_failed = self.feedback_message
         if moving is not None:
             return moving
         if last:
@@ -182,7 +185,8 @@ class TransitToReturnNode(CopsSkill):
     then continue with post-exploration (step 0).
 
     Reads/writes ``cops``; drives the robot. Returns RUNNING on the way, SUCCESS
-    there, FAILURE without a route.
+    there, FAILURE without a route (its reason kept in ``cops``,
+    ``transition_failed``).
     """
 
     def initialise(self) -> None:
@@ -191,6 +195,8 @@ class TransitToReturnNode(CopsSkill):
     def update(self) -> Status:
         st = self.state
         moving = self.drive_to(st.plan.exploration[self.ctx.name].frontier, arrive=True)
+        if moving == Status.FAILURE:
+            st.transition_failed = self.feedback_message
         if moving is not None:
             return moving
         st.part, st.step = "post", 0

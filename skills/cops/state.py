@@ -35,8 +35,9 @@ class Knowledge:
     information until they reach the base station's map.
     ``finished[r]``: the final plan's cycle, for a robot that got it at the base with
     its part done (its communications in that plan count as done).
-    ``home_by_endurance[r]``: when robot r left the plan for home because its
-    endurance barely covered the way (it takes part in no plan any more)."""
+    ``gone_home[r]``: when robot r left the plan for home (its endurance barely
+    covered the way, or it could not make a move of the plan): it takes part in no
+    plan any more."""
 
     topology: Topology = field(default_factory=Topology)
     freshness: dict[str, int] = field(default_factory=dict)
@@ -47,13 +48,12 @@ class Knowledge:
     pending_plan: dict[str, Any] | None = None
     map_chunks: dict[str, tuple[Any, Any]] = field(default_factory=dict)
     finished: dict[str, int] = field(default_factory=dict)
-    home_by_endurance: dict[str, float] = field(default_factory=dict)
+    gone_home: dict[str, float] = field(default_factory=dict)
 
     @property
     def retired(self) -> set[str]:
-        """Robots that take part in no plan any more: declared lost, or gone home by
-        endurance."""
-        return self.lost | self.home_by_endurance.keys()
+        """Robots that take part in no plan any more: declared lost, or gone home."""
+        return self.lost | self.gone_home.keys()
 
     @property
     def lost(self) -> set[str]:
@@ -62,7 +62,7 @@ class Knowledge:
     def payload(self) -> dict[str, Any]:
         return {"topology": self.topology.to_dict(), "freshness": dict(self.freshness),
                 "declared": dict(self.declared), "heard": dict(self.heard), "map": dict(self.map_chunks),
-                "finished": dict(self.finished), "home_by_endurance": dict(self.home_by_endurance)}
+                "finished": dict(self.finished), "gone_home": dict(self.gone_home)}
 
     def collect_map(self, robot: str, onboard_map: Any) -> None:
         """Add what ``robot``'s onboard map gained since the last call as a chunk."""
@@ -76,7 +76,7 @@ class Knowledge:
         self.topology.merge(Topology.from_dict(payload["topology"]))
         for mine, theirs in ((self.freshness, payload["freshness"]), (self.declared, payload["declared"]),
                              (self.heard, payload["heard"]), (self.finished, payload.get("finished", {})),
-                (self.home_by_endurance, payload.get("home_by_endurance", {}))):
+                (self.gone_home, payload.get("gone_home", {}))):
             for r, v in theirs.items():
                 mine[r] = max(mine.get(r, -math.inf), v)
 
@@ -97,6 +97,8 @@ class CopsState:
     base_location: str | None = None
     explored_in: dict[str, int] = field(default_factory=dict)
     planned_s: float = 0.0
+    #: Why the last move of the plan failed (None: no move failed).
+    transition_failed: str | None = None
 
     def part_plan(self) -> Plan | None:
         if self.plan is None:

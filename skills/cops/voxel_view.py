@@ -133,11 +133,15 @@ class VoxelNetworkView:
         name = topo.resolve(name)
         return name if name in topo.locations else None
 
+    def near(self, ground: np.ndarray) -> bool:
+        """Whether the robot's ground point is within ``ARRIVAL_RADIUS_M`` of a point."""
+        return float(np.linalg.norm(self.ground_point() - np.asarray(ground, dtype=float))) <= ARRIVAL_RADIUS_M
+
     def arrived(self, location: str) -> bool:
         """Whether the robot's ground point is within ``ARRIVAL_RADIUS_M`` of where it
         goes for the location (:meth:`target`)."""
         pos = self.target(location)
-        return pos is not None and float(np.linalg.norm(self.ground_point() - pos)) <= ARRIVAL_RADIUS_M
+        return pos is not None and self.near(pos)
 
     def route(self, location: str) -> np.ndarray | None:
         """Waypoints (N, 3) along the navigation graph from the robot to the node nearest
@@ -146,9 +150,12 @@ class VoxelNetworkView:
         else straight to it if the straight line crosses only known free space; None
         for an unknown location or when none of these is possible."""
         pos = self.target(location)
-        if pos is None:
-            return None
-        goal = pos + [0.0, 0.0, self.sight_height_m()]
+        return None if pos is None else self.route_towards(pos)
+
+    def route_towards(self, ground: np.ndarray) -> np.ndarray | None:
+        """As :meth:`route`, to a ground point: a location the team knows and this
+        robot's map does not show yet (another robot explored it)."""
+        goal = np.asarray(ground, dtype=float) + [0.0, 0.0, self.sight_height_m()]
         plan, target = self._plan_towards(goal, force=False)
         if target is None and self.navigator.map_changed():
             plan, target = self._plan_towards(goal, force=True)

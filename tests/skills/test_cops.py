@@ -364,8 +364,9 @@ def walker_context(robot, events: list, **services) -> AgentContext:
 
 
 def test_a_failed_transition_is_an_event_with_its_reason():
-    """The plan sends r1 from s0 to s1, which it cannot reach: the tree fails and the
-    log says who, from where, to where and why."""
+    """The plan sends r1 from s0 to s1, which it cannot reach: the action fails, the
+    log says who, from where, to where and why, and the state keeps why (the robot
+    then leaves the plan for home, reason "transition failed: ...")."""
     events: list = []
     ctx = walker_context(BlockedWalker(at=0, blocked={"s1"}), events)
     action = TransitionAction("Transition action", ctx)
@@ -377,6 +378,10 @@ def test_a_failed_transition_is_an_event_with_its_reason():
     assert [f for e, f in events if e == "cops_transition_failed"] == [
         {"agent": "r1", "node": "Transition action", "robot": "r1", "cycle": 2, "part": "pre", "step": 0,
          "reason": "no route to s1", "from": "s0", "to": "s1"}]
+    assert st.transition_failed == "no route to s1"
+    leave = LeavePlan("Leave the plan", ctx)
+    leave.tick_once()
+    assert events[-1][1]["reason"] == "transition failed: no route to s1" and "r1" in st.knowledge.gone_home
     py_trees.blackboard.Blackboard.clear()
 
 
@@ -403,7 +408,7 @@ def test_a_name_merged_into_a_region_is_driven_to_under_the_region_s_name():
     py_trees.blackboard.Blackboard.clear()
 
 
-def test_a_robot_home_by_endurance_leaves_the_plan_goes_to_the_base_and_says_so():
+def test_a_robot_low_on_endurance_leaves_the_plan_goes_to_the_base_and_says_so():
     events: list = []
     robot = Walker(at=3)
     radio = Radio()
@@ -413,8 +418,8 @@ def test_a_robot_home_by_endurance_leaves_the_plan_goes_to_the_base_and_says_so(
                           GreetBase("Tell the base", ctx, greetings=2, greet_period_s=5.0))
     leave.tick_once()
     st = leave.state
-    assert leave.status == Status.SUCCESS and st.knowledge.home_by_endurance == {"r1": 0.0}
-    assert [e for e, _ in events] == ["cops_home_by_endurance"] and events[0][1]["at"] == "s3"
+    assert leave.status == Status.SUCCESS and st.knowledge.gone_home == {"r1": 0.0}
+    assert [(e, f["at"], f["reason"]) for e, f in events] == [("cops_left_plan", "s3", "endurance")]
     for _ in range(3):
         home.tick_once()
         assert home.status == Status.RUNNING
@@ -426,18 +431,18 @@ def test_a_robot_home_by_endurance_leaves_the_plan_goes_to_the_base_and_says_so(
         greet.tick_once()
     assert greet.status == Status.SUCCESS
     hellos = [d for to, _k, d in radio.sent if to == "base" and d["type"] == "hello"]
-    assert len(hellos) == 2 and hellos[0]["payload"]["home_by_endurance"] == {"r1": 0.0}
+    assert len(hellos) == 2 and hellos[0]["payload"]["gone_home"] == {"r1": 0.0}
     py_trees.blackboard.Blackboard.clear()
 
 
-def test_the_team_plans_without_a_robot_home_by_endurance(relay):
-    """r4 went home by endurance: r3 does not wait for it, and the leader neither plans
+def test_the_team_plans_without_a_robot_gone_home(relay):
+    """r4 left the plan for home: r3 does not wait for it, and the leader neither plans
     it nor waits for it at the end."""
-    relay.st.knowledge.home_by_endurance["r4"] = 10.0
+    relay.st.knowledge.gone_home["r4"] = 10.0
     relay.action.tick_once()
     assert [d["info"] for d in relay.radio.infos()] == ["r2"]
     ctx, storage, done, st = final_state("base", {"radio": Radio(), "team": {"r1": "s0"}})
-    st.knowledge.home_by_endurance["r1"] = 60.0
+    st.knowledge.gone_home["r1"] = 60.0
     done.tick_once()
     assert done.status == Status.SUCCESS and "r1" not in st.knowledge.lost
     st.base_location = "s0"
@@ -446,7 +451,7 @@ def test_the_team_plans_without_a_robot_home_by_endurance(relay):
     py_trees.blackboard.Blackboard.clear()
 
 
-def test_with_every_robot_home_by_endurance_the_leader_plans_the_last_recall():
+def test_with_every_robot_gone_home_the_leader_plans_the_last_recall():
     """Frontiers are left, but nobody to explore them: the mission is over, not failed."""
     events: list = []
     py_trees.blackboard.Blackboard.clear()
@@ -459,7 +464,41 @@ def test_with_every_robot_home_by_endurance_the_leader_plans_the_last_recall():
         st.knowledge.topology.add_location(f"s{i}", (50.0 * i, 0.0, 0.0), explored=i < 2)
     for i in range(2):
         st.knowledge.topology.add_mobility_edge(f"s{i}", f"s{i + 1}", 50.0)
-    st.knowledge.home_by_endurance["r1"] = 5.0
+    st.knowledge.gone_home["r1"] = 5.0
     solve.tick_once()
     assert solve.status == Status.SUCCESS and st.final and events == ["cops_plan"]
+    py_trees.blackboard.Blackboard.clear()
+
+
+class ShortSightedWalker(RegionWalker):
+    """A Walker whose own map shows s0..s3 only; it can walk towards any point."""
+
+    def location(self) -> str | None:
+        return f"s{self.at}" if self.at < 4 else None
+
+    def resolve(self, name: str) -> str | None:
+        return name if int(name[1:]) < 4 else None
+
+    def route_towards(self, point) -> list[float]:
+        return [float(point[0])]
+
+    def near(self, point) -> bool:
+        return abs(self.at - point[0]) < 0.5
+
+
+def test_a_location_only_a_partner_has_mapped_is_driven_to_where_the_knowledge_puts_it():
+    events: list = []
+    robot = ShortSightedWalker(at=3)
+    ctx = walker_context(robot, events)
+    action = TransitionAction("Transition action", ctx)
+    step = Plan(horizon=1, trajectories={"r1": ["s3", "s6"]}, masters=["r1"], phase="pre")
+    st = action.state
+    st.knowledge.topology.add_location("s6", (6.0, 0.0, 0.0), explored=True)
+    st.plan, st.cycle, st.part, st.step = CyclePlan(step, step, {}), 2, "pre", 0
+    for _ in range(3):
+        action.tick_once()
+        assert action.status == Status.RUNNING and robot.goal == 6
+        robot.step()
+    action.tick_once()
+    assert action.status == Status.SUCCESS and robot.at == 6 and events == []
     py_trees.blackboard.Blackboard.clear()
