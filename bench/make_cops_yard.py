@@ -3,10 +3,12 @@
     .venv/bin/python bench/make_cops_yard.py OUT_DIR
 
 The model (OUT_DIR/yard.ply) is built like a Gazebo model: floor slabs and wall
-boxes, no ceiling, metres, z up. Its floor plan: a 30 m x 30 m yard, reached from
-the portal by a 4 m drift 12 m long from the south, with two drifts leaving it (north,
-24 m, and east, 20 m). The scenario (OUT_DIR/cops_yard.yaml): the base station and
-three legged robots at the portal, the shipped COPS trees, endurance 1500 s each.
+boxes, no ceiling, metres, z up. Its floor plan: a 56 m x 40 m yard, reached from
+the portal by a 4 m drift 12 m long from the south, with three drifts leaving it
+(north, 30 m; east and west, 22 m). The scenario (OUT_DIR/cops_yard.yaml): the base
+station and three legged robots at the portal (the world's start, where the base
+station stands), the shipped COPS trees, endurance 1200 s each (the legged
+platform's 1800 s less a third: the team cannot dawdle).
 
 Then: ``delve run OUT_DIR/cops_yard.yaml --out DIR``.
 """
@@ -23,7 +25,7 @@ from delve import TREES_DIR
 
 #: Axis-aligned floor rectangles (x0, y0, x1, y1), metres: the portal drift, the
 #: yard, the drifts that leave it.
-RECTANGLES = [(-2, -12, 2, 0), (-15, 0, 15, 30), (-2, 30, 2, 54), (15, 13, 35, 17)]
+RECTANGLES = [(-2, -12, 2, 0), (-28, 0, 28, 40), (-2, 40, 2, 70), (28, 18, 50, 22), (-50, 30, -28, 34)]
 HEIGHT_M, WALL_M, SLAB_M = 4.0, 0.5, 0.3
 #: The floor plan's raster (walls are built from it).
 CELL_M = 0.25
@@ -65,6 +67,7 @@ duration_s: 3600
 world:
   mesh: yard.ply
   voxel_size_m: 0.2
+  start: [{start}]
 team: {{strategy: cops}}
 base_station:
   tree: {trees}/cops_base_voxel.yaml
@@ -82,10 +85,10 @@ def write(out: Path) -> list[Path]:
     yard_mesh().export(ply)
     robots = "".join(
         f"  - {{name: r{i + 1}, platform: legged, tree: {TREES_DIR}/cops_robot.yaml, tick_hz: 5.0, "
-        f"endurance_s: 1500, start: [{START[0] + dx}, {START[1]}, {START[2]}]}}\n"
+        f"endurance_s: 1200, start: [{START[0] + dx}, {START[1]}, {START[2]}]}}\n"
         for i, dx in enumerate((-1.2, 0.0, 1.2)))
     scenario = out / "cops_yard.yaml"
-    scenario.write_text(SCENARIO.format(trees=TREES_DIR, robots=robots))
+    scenario.write_text(SCENARIO.format(trees=TREES_DIR, robots=robots, start=", ".join(map(str, START))))
     return [ply, scenario]
 
 
