@@ -157,9 +157,11 @@ class NoticeUnseenWall(Skill):
     ``radius_m`` that no camera has covered (the body cameras' and payload's record)
     and that the robot sees from where it stands.
 
-    Cheap and rate-limited: looks at most every ``check_period_s``, only in mode
-    ``when_mode`` (null: any), only when the robot carries a payload and no request is
-    pending, and not within ``min_spacing_m`` of where it last asked. When the unseen
+    Only once the supervisor enabled it (``autonomous_scans``, the paper's autonomous
+    scanning; off by default). Cheap and rate-limited: looks at most every
+    ``check_period_s``, only in mode ``when_mode`` (null: any), only when the robot
+    carries a payload and no request is pending, and not within ``min_spacing_m`` of
+    where it last asked. When the unseen
     wall is at least ``min_unseen_area_m2`` and ``min_unseen_fraction`` of the wall
     within reach, writes ``request_key`` (``{point: null, requested_s, source:
     planner}``: scan the area, as the supervisor's ``scan``) and logs
@@ -178,7 +180,9 @@ class NoticeUnseenWall(Skill):
         "when_mode": Param(str, "explore", "the mode the robot must be in (null: any)", nullable=True),
     }
     INPUT_PORTS = {"inspection_request": REQUEST_IN,
-                   "mode": PortInformation(str, required=False, description="the mode of operation")}
+                   "mode": PortInformation(str, required=False, description="the mode of operation"),
+                   "autonomous_scans": PortInformation(bool, required=False, default_value=False,
+                                                       description="True once the supervisor enabled them")}
     OUTPUT_PORTS = {"inspection_request": ParamNamedPort(dict | None, description="the planner's request",
                                                          key_param="request_key")}
 
@@ -189,7 +193,8 @@ class NoticeUnseenWall(Skill):
 
     def update(self) -> Status:
         r, now, p = self.robot, self.ctx.clock.now_s, self.p
-        if now + 1e-9 < self.next_check_s or r.payload is None or self.read("inspection_request"):
+        if not self.read("autonomous_scans", False) or now + 1e-9 < self.next_check_s or r.payload is None \
+                or self.read("inspection_request"):
             return Status.SUCCESS
         if p["when_mode"] is not None and self.read("mode") != p["when_mode"]:
             return Status.SUCCESS

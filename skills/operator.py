@@ -5,7 +5,9 @@ The commands are the CERBERUS paper's operator calls and its four modes of
 operation: explore within radio range (backing off when the link drops), explore
 with a time budget out of range, relocate to a frontier then explore, and go to a
 waypoint; plus setting the exploration bounding box, homing, cancelling, scanning
-the area or a point, and dropping a breadcrumb.
+the area or a point, dropping a breadcrumb, and letting the robot ask for scans
+where its map shows unseen wall (the paper's autonomous scanning, which the Human
+Supervisor enabled).
 """
 from __future__ import annotations
 
@@ -31,6 +33,8 @@ COMMANDS: dict[str, dict[str, Param]] = {
     "scan": {"point": Param(list, None, "point [x, y, z] to inspect; none: scan the area", nullable=True)},
     "goto": {"goal": Param(list, doc="waypoint [x, y, z] (m)")},
     "drop_breadcrumb": {},
+    "autonomous_scans": {"enabled": Param(bool, True, "whether the robot asks for inspections where its map shows "
+                                                      "unseen wall")},
 }
 
 #: Blackboard values of ``mode``.
@@ -48,7 +52,8 @@ class ProcessOperatorCommands(Skill):
     behaviours). Writes ``mode`` (idle, explore, relocate, goto, home),
     ``time_budget_s`` and ``budget_start_s`` (explore with a budget), ``goal`` and
     ``goal_source`` (goto), ``exploration_bbox``, ``inspection_request`` (scan),
-    ``breadcrumb_request``, ``end_at_home`` and ``last_command``; ``explore`` also
+    ``breadcrumb_request``, ``autonomous_scans`` (False until the supervisor enables
+    them), ``end_at_home`` and ``last_command``; ``explore`` also
     clears ``link_loss_points`` (WiFi safety's memory of the radio edge: a new
     exploring task starts afresh).
 
@@ -81,6 +86,7 @@ class ProcessOperatorCommands(Skill):
         "end_at_home": PortInformation(bool, description="True: homing ends the mission; False: it ends a sortie "
                                        "and the robot waits at home for commands"),
         "link_loss_points": PortInformation(list, description="where the radio link was lost: cleared by explore"),
+        "autonomous_scans": PortInformation(bool, description="True when the robot may ask for inspections itself"),
         "last_command": PortInformation(str | None, description="the last command applied"),
     }
 
@@ -91,6 +97,7 @@ class ProcessOperatorCommands(Skill):
         self.write("breadcrumb_request", False)
         self.write("end_at_home", self.p["end_at_home"])
         self.write("link_loss_points", [])
+        self.write("autonomous_scans", False)
         self.write("last_command", None)
 
     def update(self) -> Status:
@@ -123,5 +130,7 @@ class ProcessOperatorCommands(Skill):
             set_("inspection_request", {"point": args.get("point"), "requested_s": now})
         elif command == "drop_breadcrumb":
             set_("breadcrumb_request", True)
+        elif command == "autonomous_scans":
+            set_("autonomous_scans", bool(args.get("enabled", True)))
         set_("last_command", command)
         self.event("operator_command", trigger=True, command=command, **{k: v for k, v in args.items()})

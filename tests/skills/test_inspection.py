@@ -393,8 +393,9 @@ def test_a_point_out_of_reach_is_walked_to_then_the_same_path_resumed(tunnel):
     assert read("inspection_result")["covered_fraction"] > 0.9
 
 
-def mode(value: str) -> None:
+def mode(value: str, autonomous_scans: bool = True) -> None:
     py_trees.blackboard.Blackboard.set("/r1/mode", value)
+    py_trees.blackboard.Blackboard.set("/r1/autonomous_scans", autonomous_scans)
 
 
 def test_the_robot_requests_a_scan_where_its_map_shows_unseen_wall(tunnel):
@@ -407,6 +408,9 @@ def test_the_robot_requests_a_scan_where_its_map_shows_unseen_wall(tunnel):
     notice = build_tree({"type": "NoticeUnseenWall", "check_period_s": 10.0, "min_spacing_m": 6.0}, ctx)
     notice.tick_once()
     assert notice.status == Status.SUCCESS and read("inspection_request") is None  # not exploring
+    mode("explore", autonomous_scans=False)
+    notice.tick_once()
+    assert read("inspection_request") is None  # the supervisor has not enabled it
     mode("explore")
     notice.tick_once()
     asked = read("inspection_request")

@@ -13,7 +13,7 @@ from py_trees.common import Status
 from .fakes import FakeRobot, bb, body, build, events, make_ctx
 
 KEYS = ("mode", "time_budget_s", "budget_start_s", "goal", "goal_source", "exploration_bbox",
-        "inspection_request", "breadcrumb_request", "end_at_home", "last_command")
+        "inspection_request", "breadcrumb_request", "end_at_home", "autonomous_scans", "last_command")
 
 
 @pytest.fixture(scope="module")
@@ -42,7 +42,8 @@ def state() -> dict:
 def test_setup_writes_the_initial_state(agent):
     assert state() == {"mode": "idle", "time_budget_s": None, "budget_start_s": None, "goal": None,
                        "goal_source": None, "exploration_bbox": None, "inspection_request": None,
-                       "breadcrumb_request": False, "end_at_home": True, "last_command": None}
+                       "breadcrumb_request": False, "end_at_home": True, "autonomous_scans": False,
+                       "last_command": None}
 
 
 def test_the_initial_mode_is_a_parameter(tunnel):
@@ -79,6 +80,7 @@ CASES = {
     "goto": ({"goal": [20.0, 6.0, 1.5]},
              {"mode": "goto", "goal": [20.0, 6.0, 1.5], "goal_source": "supervisor", "end_at_home": False}),
     "drop_breadcrumb": ({}, {"breadcrumb_request": True}),
+    "autonomous_scans": ({"enabled": True}, {"autonomous_scans": True}),
 }
 
 
