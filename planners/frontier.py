@@ -21,10 +21,9 @@ from .occupancy import FREE, OCCUPIED, UNKNOWN, Grid
 
 @dataclass(frozen=True)
 class FrontierCluster:
-    """A connected set of frontier voxels: their flat indices, their centres and the centroid."""
+    """A connected set of frontier voxels: their flat indices and world centroid."""
 
     voxels: np.ndarray
-    points: np.ndarray
     centroid: np.ndarray
 
     @property
@@ -71,6 +70,11 @@ def frontier_voxels(grid: Grid, among: np.ndarray | None = None, depth: int = FR
 #: Viewpoints tried per frontier voxel for a line of sight, spread from the nearest
 #: to the farthest of those whose elevation the sensor covers (bounds the work).
 SIGHT_TRIES = 6
+#: Viewpoints that may observe a frontier are one node per cell of this size (m) ...
+VIEWPOINT_SPACING_M = 1.2
+#: ... and a voxel's nearest this many of them (bounds the memory: they cover 12 m
+#: of a 4 m wide drift either way, or a ball of about 4 m in open 3-D space).
+VIEWPOINTS_PER_VOXEL = 128
 #: A goal node, and a viewpoint that counts, is at most this far from its frontier (m).
 MAX_GOAL_OFFSET_M = 12.0
 #: Goal and viewpoint candidates are thinned to one node per cell of this size (m).
@@ -133,32 +137,29 @@ def observable_frontiers(grid: Grid, voxels: np.ndarray, viewpoints: np.ndarray,
     visits them, and calling them frontiers sends it to look again and again and
     leaves them on the map. A voxel is observable when, from at least one viewpoint,
     it lies within ``view_up_deg`` above the sensor (with half a voxel of slack) and
-    the line to it crosses no known rock (:func:`clear_sight`); up to ``tries``
-    viewpoints per voxel are tried, spread from the nearest to the farthest.
+    the line to it crosses no known rock (:func:`clear_sight`); of its
+    :data:`VIEWPOINTS_PER_VOXEL` nearest viewpoints, up to ``tries`` are tried,
+    spread from the nearest to the farthest.
     """
     if len(voxels) == 0 or len(viewpoints) == 0:
         return voxels[:0]
     pts = grid.to_world(np.stack(np.unravel_index(voxels, grid.shape), axis=1))
-    near = cKDTree(viewpoints).query_ball_point(pts, reach_m)
-    owner = np.repeat(np.arange(len(voxels)), [len(n) for n in near])
-    if len(owner) == 0:
-        return voxels[:0]
-    vp = np.concatenate([np.asarray(n, dtype=np.int64) for n in near])
-    keep = in_view(viewpoints[vp], pts[owner], view_up_deg, 0.5 * grid.voxel_size_m)
-    owner, vp = owner[keep], vp[keep]
-    dist = np.linalg.norm(viewpoints[vp] - pts[owner], axis=1)
-    order = np.lexsort((dist, owner))
-    owner, vp = owner[order], vp[order]
-    count = np.bincount(owner, minlength=len(voxels))
-    first = np.cumsum(count) - count
+    k = min(VIEWPOINTS_PER_VOXEL, len(viewpoints))
+    dist, vp = cKDTree(viewpoints).query(pts, k=k, distance_upper_bound=reach_m)
+    dist, vp = dist.reshape(len(pts), k), vp.reshape(len(pts), k)   # nearest first
+    ok = np.isfinite(dist)
+    ok[ok] = in_view(viewpoints[vp[ok]], np.broadcast_to(pts[:, None], (len(pts), k, 3))[ok], view_up_deg,
+                     0.5 * grid.voxel_size_m)
+    count = ok.sum(axis=1)
+    rank = np.argsort(~ok, axis=1, kind="stable")   # each voxel's usable viewpoints first, nearest first
     seen = np.zeros(len(voxels), dtype=bool)
-    for k in range(tries):
-        todo = np.flatnonzero(~seen & (count > k))
+    for t in range(tries):
+        todo = np.flatnonzero(~seen & (count > t))
         if len(todo) == 0:
             break
-        # the k-th of ``tries`` picks, spread over each voxel's candidates by distance
-        pick = first[todo] + (k * count[todo]) // np.minimum(count[todo], tries)
-        seen[todo] = clear_sight(grid, viewpoints[vp[pick]], pts[todo])
+        # the t-th of ``tries`` picks, spread over each voxel's usable viewpoints by distance
+        pick = rank[todo, (t * count[todo]) // np.minimum(count[todo], tries)]
+        seen[todo] = clear_sight(grid, viewpoints[vp[todo, pick]], pts[todo])
     return voxels[seen]
 
 
@@ -195,15 +196,8 @@ def frontier_clusters(grid: Grid, voxels: np.ndarray, *, cluster_radius_m: float
     for c in range(labels.max() + 1):
         members = order[bounds[c] : bounds[c + 1]]
         if len(members) >= min_cluster_voxels:
-            clusters.append(FrontierCluster(voxels=voxels[members], points=pts[members],
-                                            centroid=pts[members].mean(axis=0)))
+            clusters.append(FrontierCluster(voxels=voxels[members], centroid=pts[members].mean(axis=0)))
     return clusters
-
-
-#: Cluster voxels sampled (evenly) to judge what a goal node sees of a cluster.
-VIEW_SAMPLES = 64
-#: Goal candidates, cheapest first, whose line of sight is checked before giving up on a cluster.
-SIGHT_CANDIDATES = 200
 
 
 def nearest_frontier(
@@ -216,22 +210,17 @@ def nearest_frontier(
     sensor_height_m: float = 0.0,
     offset_weight: float = 2.0,
     node_spacing_m: float = NODE_SPACING_M,
-    view_fraction: float = 0.8,
-    grid: Grid | None = None,
 ) -> FrontierGoal | None:
     """The cluster whose goal node is cheapest: path length from the robot
     (``distances``) plus ``offset_weight`` times the straight distance to the cluster.
 
     A goal node must lie within ``max_goal_offset_m`` of the cluster's centroid and
-    see it: at least ``view_fraction`` of the cluster's voxels may be at most
-    ``view_up_deg`` above the sensor (``sensor_height_m`` above the node), and, with
-    ``grid``, the lines to them cross no known rock. Judging each voxel, not the
-    centroid, matters for a LiDAR with a narrow vertical field of view: a cluster
-    that spans a drift from the floor to the roof has its centroid low, and from a
-    node next to it the roof part is out of view, so the visit would leave most of it
-    a frontier. A far goal approaches a frontier the map cannot reach yet; a weight
-    above 1 makes the node nearest the frontier win over the robot's own. Candidate
-    nodes are thinned to one per ``node_spacing_m`` cell. None when no cluster has a goal.
+    see it: the centroid may be at most ``view_up_deg`` above the sensor
+    (``sensor_height_m`` above the node), so a ceiling frontier is approached from
+    where a LiDAR with a narrow vertical field of view can see it, not from below. A
+    far goal approaches a frontier the map cannot reach yet; a weight above 1 makes
+    the node nearest the frontier win over the robot's own. Candidate nodes are
+    thinned to one per ``node_spacing_m`` cell. None when no cluster has a goal.
     """
     nodes = viewpoint_nodes(graph, distances, node_spacing_m)
     if len(nodes) == 0 or not clusters:
@@ -243,39 +232,12 @@ def nearest_frontier(
         return None
     cand = nodes[np.concatenate([np.asarray(n, dtype=np.int64) for n in near])]
     offset = np.linalg.norm(centroids[owner] - graph.positions[cand], axis=1)
-    samples = [_view_samples(c) for c in clusters]
     sensor = graph.positions[cand] + np.array([0.0, 0.0, sensor_height_m])
-    cost = np.where(_view_fractions(sensor, owner, samples, view_up_deg, 0.5 * node_spacing_m) >= view_fraction,
-                    distances[cand] + offset_weight * offset, np.inf)
-    for k in np.argsort(cost, kind="stable")[:SIGHT_CANDIDATES]:
-        if not np.isfinite(cost[k]):
-            return None
-        pts = samples[owner[k]]
-        if grid is not None:
-            sight = in_view(np.broadcast_to(sensor[k], pts.shape), pts, view_up_deg, 0.5 * node_spacing_m)
-            sight &= clear_sight(grid, np.broadcast_to(sensor[k], pts.shape), pts)
-            if sight.mean() < view_fraction:
-                continue
-        node = int(cand[k])
-        return FrontierGoal(cluster=clusters[owner[k]], node=node, path_length_m=float(distances[node]),
-                            offset_m=float(offset[k]))
-    return None
-
-
-def _view_fractions(sensor: np.ndarray, owner: np.ndarray, samples: list[np.ndarray], view_up_deg: float,
-                    slack_m: float) -> np.ndarray:
-    """For each sensor position, the fraction of its cluster's (``owner``) sample
-    points within ``view_up_deg`` above it (:func:`in_view`), all pairs at once."""
-    sizes = np.array([len(p) for p in samples])
-    first = np.cumsum(sizes) - sizes
-    flat = np.concatenate(samples)
-    pair = np.repeat(np.arange(len(owner)), sizes[owner])
-    point = np.arange(len(pair)) - np.repeat(np.cumsum(sizes[owner]) - sizes[owner], sizes[owner])
-    seen = in_view(sensor[pair], flat[first[owner][pair] + point], view_up_deg, slack_m)
-    return np.bincount(pair, weights=seen, minlength=len(owner)) / sizes[owner]
-
-
-def _view_samples(cluster: FrontierCluster) -> np.ndarray:
-    """Up to :data:`VIEW_SAMPLES` of the cluster's voxel centres, evenly spread."""
-    pts = cluster.points
-    return pts[:: max(1, -(-len(pts) // VIEW_SAMPLES))]
+    seen = in_view(sensor, centroids[owner], view_up_deg, 0.5 * node_spacing_m)
+    cost = np.where(seen, distances[cand] + offset_weight * offset, np.inf)
+    k = int(np.argmin(cost))
+    if not np.isfinite(cost[k]):
+        return None
+    node = int(cand[k])
+    return FrontierGoal(cluster=clusters[owner[k]], node=node, path_length_m=float(distances[node]),
+                        offset_m=float(offset[k]))

@@ -7,8 +7,8 @@ import numpy as np
 from py_trees.common import Status
 from py_trees.ports import PortInformation
 
-from ..planners.frontier import (MAX_GOAL_OFFSET_M, FrontierCluster, FrontierGoal, frontier_clusters, frontier_voxels,
-                                 nearest_frontier, observable_frontiers, viewpoint_nodes)
+from ..planners.frontier import (MAX_GOAL_OFFSET_M, VIEWPOINT_SPACING_M, FrontierCluster, FrontierGoal, frontier_clusters,
+                                 frontier_voxels, nearest_frontier, observable_frontiers, viewpoint_nodes)
 from ..planners.occupancy import Grid
 from ..planners.geometry import xyz
 from .base import Param, Skill
@@ -21,9 +21,8 @@ class ExploreFrontiers(Skill):
 
     Frontier voxels (known free next to unknown) of the onboard map that the robot's
     LiDAR could observe from a node it can reach (within its view up, with a clear
-    line) are clustered; the cluster whose goal node, one that sees most of the
-    cluster, is nearest along the navigation graph is chosen and the robot follows the
-    path to it. The voxels of a cluster that is still a frontier after a visit, or
+    line) are clustered; the cluster whose goal node is nearest along the navigation
+    graph is chosen and the robot follows the path to it. The voxels of a cluster that is still a frontier after a visit, or
     whose path is blocked, are blacklisted: never goals again.
 
     Writes: ``frontier_goal`` (x, y, z of the current goal), ``frontiers_left`` (clusters).
@@ -119,7 +118,7 @@ float, 2.0, "how often the target cluster is re-checked", exclusive_minimum=0),
                 return Status.FAILURE
             clusters = self._clusters(grid, plan, candidates)
             self.write("frontiers_left", len(clusters))
-            goal = self._choose(plan, clusters, grid)
+            goal = self._choose(plan, clusters)
             if goal is not None:
                 break
         else:
@@ -137,19 +136,18 @@ float, 2.0, "how often the target cluster is re-checked", exclusive_minimum=0),
     def _clusters(self, grid: Grid, plan: Plan, candidates: np.ndarray) -> list[FrontierCluster]:
         """Clusters of the ``candidates`` (frontier voxels) that the robot's sensor can
         observe from a node it can reach (:func:`observable_frontiers`)."""
-        viewpoints = plan.graph.positions[viewpoint_nodes(plan.graph, plan.distances)]
+        viewpoints = plan.graph.positions[viewpoint_nodes(plan.graph, plan.distances, VIEWPOINT_SPACING_M)]
         seen = observable_frontiers(grid, candidates, viewpoints,
                                     view_up_deg=self.robot.view_up_deg, reach_m=self.p["max_goal_offset_m"])
         return frontier_clusters(grid, seen, cluster_radius_m=self.p["cluster_radius_m"],
                                  min_cluster_voxels=self.p["min_cluster_voxels"],
                                  max_extent_m=self.p["max_cluster_extent_m"])
 
-    def _choose(self, plan: Plan, clusters: list[FrontierCluster], grid: Grid) -> FrontierGoal | None:
+    def _choose(self, plan: Plan, clusters: list[FrontierCluster]) -> FrontierGoal | None:
         """The nearest frontier whose goal is not where the robot already stands."""
         while True:
             goal = nearest_frontier(plan.graph, plan.distances, clusters, max_goal_offset_m=self.p["max_goal_offset_m"],
-                                    view_up_deg=self.robot.view_up_deg, view_fraction=self.p["explored_fraction"],
-                                    grid=grid)
+                                    view_up_deg=self.robot.view_up_deg)
             if goal is None or goal.node != plan.source:
                 return goal
             if goal.offset_m <= self.p["observe_radius_m"]:

@@ -10,7 +10,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from ...planners.frontier import MAX_GOAL_OFFSET_M, frontier_voxels, observable_frontiers, viewpoint_nodes  # noqa: E402
+from ...planners.frontier import (MAX_GOAL_OFFSET_M, VIEWPOINT_SPACING_M, frontier_voxels,  # noqa: E402
+                                  observable_frontiers, viewpoint_nodes)
 from ...planners.occupancy import Grid  # noqa: E402
 from ...skills.navigation import navigator  # noqa: E402
 
@@ -33,7 +34,7 @@ def frontiers_left(mission: "Mission", name: str) -> np.ndarray:
     front = frontier_voxels(grid)
     plan = navigator(mission.agents[name].ctx, robot).from_robot(force=True) if name in mission.agents else None
     if plan is not None:
-        views = plan.graph.positions[viewpoint_nodes(plan.graph, plan.distances)]
+        views = plan.graph.positions[viewpoint_nodes(plan.graph, plan.distances, VIEWPOINT_SPACING_M)]
         front = observable_frontiers(grid, front, views, view_up_deg=robot.view_up_deg, reach_m=MAX_GOAL_OFFSET_M)
     return grid.to_world(np.stack(np.unravel_index(front, m.shape), axis=1))
 
