@@ -50,6 +50,7 @@ class SignalCluster:
     artifact_class: str
     positions: list[np.ndarray] = field(default_factory=list)
     values: list[float] = field(default_factory=list)
+    since_peak: int = 0
     reported: bool = False
 
     def strongest(self, top_k: int) -> np.ndarray:
@@ -84,17 +85,24 @@ class SignalClusterer:
         completes (at most one per cluster, ever), else []. ValueError for another
         kind or a Bluetooth reading without identifier."""
         kind_params = self._kind(kind)
-        if value < kind_params.threshold:
-            return []
         position = np.asarray(position, float).reshape(3)
-        cluster = self._bluetooth_cluster(identifier) if kind == "bluetooth" else self._co2_cluster(position)
+        above = value >= kind_params.threshold
+        if kind == "bluetooth":
+            cluster = self._bluetooth_cluster(identifier, create=above)
+        else:
+            cluster = self._co2_cluster(position, create=above)
         if cluster is None:
             return []
-        cluster.positions.append(position)
-        cluster.values.append(kind_params.normalise(value))
+        normalised = kind_params.normalise(value)
+        if above:
+            cluster.since_peak = 0 if normalised > max(cluster.values, default=-1.0) else cluster.since_peak + 1
+            cluster.positions.append(position)
+            cluster.values.append(normalised)
+        else:
+            cluster.since_peak += 1
         if cluster.reported or len(cluster.values) < kind_params.min_readings:
             return []
-        if len(cluster.values) - 1 - cluster.strongest(1)[0] < kind_params.after_peak_readings:
+        if cluster.since_peak < kind_params.after_peak_readings:
             return []
         cluster.reported = True
         strength = float(np.mean(np.asarray(cluster.values)[cluster.strongest(kind_params.top_k)]))
@@ -108,20 +116,21 @@ class SignalClusterer:
             return self.params.co2
         raise ValueError(f"unknown signal kind {kind!r} (bluetooth or co2)")
 
-    def _bluetooth_cluster(self, identifier: str | None) -> SignalCluster | None:
+    def _bluetooth_cluster(self, identifier: str | None, create: bool) -> SignalCluster | None:
+        """The SSID's cluster; a new one when ``create`` and the SSID names a class."""
         if not identifier:
             raise ValueError("a bluetooth reading needs its identifier (SSID)")
-        if identifier not in self._by_ssid:
+        if identifier not in self._by_ssid and create:
             artifact_class = self.classify(identifier)
             if artifact_class is None:
                 return None
             self._by_ssid[identifier] = SignalCluster("bluetooth", identifier, artifact_class)
             self.clusters.append(self._by_ssid[identifier])
-        return self._by_ssid[identifier]
+        return self._by_ssid.get(identifier)
 
-    def _co2_cluster(self, position: np.ndarray) -> SignalCluster:
+    def _co2_cluster(self, position: np.ndarray, create: bool) -> SignalCluster | None:
         """The nearest CO2 cluster within ``cluster_distance_m`` of ``position`` (the
-        older of equals), else a new one."""
+        older of equals), else a new one when ``create``."""
         top_k = self.params.co2.top_k
         co2 = [c for c in self.clusters if c.kind == "co2"]
         if co2:
@@ -129,6 +138,8 @@ class SignalClusterer:
             i = int(np.argmin(dist))
             if dist[i] <= self.params.co2.cluster_distance_m:
                 return co2[i]
+        if not create:
+            return None
         cluster = SignalCluster("co2", None, GAS_CLASS)
         self.clusters.append(cluster)
         return cluster

@@ -33,6 +33,7 @@ def rank_key(c: Candidate) -> tuple:
 
 
 def is_strong(c: Candidate, params: SubmissionParams) -> bool:
+    """Probable enough, or confirmed by enough robots."""
     return c.probability >= params.strong_probability or len(c.robots) >= params.confirm_robots
 
 

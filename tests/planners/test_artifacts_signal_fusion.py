@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from delve.planners.artifacts.params import SignalFusionParams
+from delve.planners.artifacts.params import SignalFusionParams, SignalParams
 from delve.planners.artifacts.signal_fusion import SignalClusterer, ssid_class
 
 PHONE = np.array([20.0, 3.0, 1.0])
@@ -45,11 +45,13 @@ def test_bluetooth_clusters_per_ssid_and_reports_near_the_strongest_readings():
 
 
 def test_no_report_before_enough_readings_above_threshold():
-    s = SignalClusterer()
+    bluetooth = SignalParams(raw_min=-100.0, raw_max=-40.0, threshold=-72.0, min_readings=5, after_peak_readings=0)
+    s = SignalClusterer(SignalFusionParams(bluetooth=bluetooth))
     near = PHONE + [1.0, 0.0, 0.0]
-    for i in range(20):                                            # below -80 dBm: ignored
+    for i in range(20):                                            # below -72 dBm: no cluster
         assert s.add(float(i), "bluetooth", "cell_phone_3", near, -85.0) == []
-    n = SignalFusionParams().bluetooth.min_readings
+    assert s.clusters == []
+    n = bluetooth.min_readings
     for i in range(n - 1):
         assert s.add(float(i), "bluetooth", "cell_phone_3", near, -60.0) == []
     r = s.add(99.0, "bluetooth", "cell_phone_3", near, -60.0)
@@ -60,12 +62,13 @@ def test_no_report_before_enough_readings_above_threshold():
 def test_a_rising_signal_is_reported_only_after_its_peak():
     s = SignalClusterer()
     after = SignalFusionParams().bluetooth.after_peak_readings
-    approach = _walk(0.0, 20.0, 21)                                   # up to beside the phone, 3 m away
-    assert all(s.add(float(i), "bluetooth", "cube_1", p, _rssi(p, PHONE)) == [] for i, p in enumerate(approach))
-    leave = _walk(21.0, 30.0, 10)
+    cube = np.array([20.0, 1.5, 1.0])
+    approach = _walk(0.0, 20.0, 21)                                   # up to beside the cube, 1.5 m away
+    assert all(s.add(float(i), "bluetooth", "cube_1", p, _rssi(p, cube)) == [] for i, p in enumerate(approach))
+    leave = _walk(21.0, 30.0, 10)                                     # weaker readings, soon below threshold
     reports = [(i, r) for i, p in enumerate(leave)
-               for r in s.add(30.0 + i, "bluetooth", "cube_1", p, _rssi(p, PHONE))]
-    assert [i for i, _ in reports] == [after - 1]                     # the third reading past the peak
+               for r in s.add(30.0 + i, "bluetooth", "cube_1", p, _rssi(p, cube))]
+    assert [i for i, _ in reports] == [after - 1]                     # the eighth reading past the peak
     assert np.linalg.norm(reports[0][1].position - [20.0, 0.0, 1.0]) < 1.0
 
 
