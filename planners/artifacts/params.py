@@ -97,8 +97,8 @@ class SignalParams:
 
     - ``raw_min``, ``raw_max``: the "predefined range"; a raw value v is normalised
       to clip((v - raw_min) / (raw_max - raw_min), 0, 1).
-    - ``threshold``: raw value (dBm, ppm) a reading must reach to count; readings
-      below it are ignored.
+    - ``threshold``: raw value (dBm, ppm) a reading must reach to start or join a
+      cluster; a weaker one only counts towards ``after_peak_readings``.
     - ``cluster_distance_m``: a reading farther than this from every cluster's centre
       starts a new cluster (CO2); None clusters by identifier alone (Bluetooth SSID).
     - ``min_readings``: readings above threshold a cluster needs to be reported.

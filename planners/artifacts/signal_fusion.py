@@ -2,10 +2,10 @@
 (CERBERUS paper, section 3.5, "Bluetooth and CO2 detection").
 
 Raw values are normalised to [0, 1] over a predefined range per kind
-(:class:`~.params.SignalParams`). A reading below its kind's threshold is ignored.
-Bluetooth readings are clustered by identifier (SSID); a CO2 reading joins the
-nearest CO2 cluster whose centre lies within ``cluster_distance_m``, else it starts a
-new one. A cluster's centre is the mean of the positions of its ``top_k`` strongest
+(:class:`~.params.SignalParams`). Only readings above their kind's threshold start or
+join clusters (a weaker one counts only as a reading after the peak). Bluetooth
+readings are clustered by identifier (SSID); a CO2 reading joins the nearest CO2
+cluster whose centre lies within ``cluster_distance_m``, else it starts a new one. A cluster's centre is the mean of the positions of its ``top_k`` strongest
 readings, weighted by their normalised values. A cluster is reported once, when it
 holds ``min_readings`` readings and its strongest reading is followed by
 ``after_peak_readings`` weaker ones (the robot has passed the source); later readings
