@@ -66,6 +66,8 @@ TUNNEL_BREACH_M = 6.0
 THREE_DRIFTS_FROM_M = 300.0
 #: The crossover drift to the cave leaves the southern drift this far along it.
 CAVE_CROSSOVER_AT = 0.7
+#: ... and ends this far south of the Tunnel section's box, where the cave's trunk meets it.
+CAVE_CROSSOVER_OUT_M = 3.0
 #: Cave section: passage width and height ranges (m), the cavern's length as a share
 #: of the section (within 0.75-2 cavern widths), the box's area per metre of passage
 #: (m^2/m), its least depth and how far it reaches west of the hall (m).
@@ -109,11 +111,13 @@ def plan_entrance_and_hall(plan: CoursePlan, slope_deg: float, v: float) -> dict
 
 
 class TunnelSection:
-    """The drifts of the Tunnel section: stations on two or three parallel drifts."""
+    """The drifts of the Tunnel section: stations on two or three parallel drifts, the
+    breach from the hall's east node, crosscuts; :meth:`fill` adds the side cuts.
+    ``lo``/``hi`` bound it in x and y (m)."""
 
     def __init__(self, plan: CoursePlan, rng: np.random.Generator, east: int, budget_m: float,
                  v: float):
-        self.plan, self.rng, self.v = plan, rng, v
+        self.plan, self.rng = plan, rng
         self.n_drifts = 3 if budget_m >= THREE_DRIFTS_FROM_M else 2
         ys = [DRIFT_SPACING_M, 0.0, -DRIFT_SPACING_M][3 - self.n_drifts:]
         gaps = self.n_drifts - 1
@@ -146,10 +150,10 @@ class TunnelSection:
         self.lo = np.array([plan.pos[east][0], ys[-1] - reach])
         self.hi = np.array([x0 + (self.m - 1) * DRIFT_STATION_M + reach, ys[0] + reach])
 
-    def join(self, a: int, b: int, kind: str = "tunnel") -> None:
+    def join(self, a: int, b: int) -> None:
         """A drift of random size between two nodes."""
         self.plan.join(a, b, float(self.rng.uniform(*DRIFT_WIDTH_M)),
-                       float(self.rng.uniform(*DRIFT_HEIGHT_M)), kind, "tunnel", "tunnel")
+                       float(self.rng.uniform(*DRIFT_HEIGHT_M)), "tunnel", "tunnel", "tunnel")
 
     def station_near(self, drift: int, x: float) -> int:
         """The station of a drift (0 = northernmost, -1 = southernmost) nearest to x."""
@@ -217,7 +221,7 @@ def build_course(seed: int, lengths: dict[str, float], entrance_slope_deg: float
     tunnel.join(edge, tunnel.station_near(0, foot[0]))
     south = tunnel.stations[-1][int(round(CAVE_CROSSOVER_AT * (tunnel.m - 1)))]
     s = plan.pos[south]
-    target = plan.add_node([s[0], tunnel.lo[1] - 3.0, s[2]], "cave")
+    target = plan.add_node([s[0], tunnel.lo[1] - CAVE_CROSSOVER_OUT_M, s[2]], "cave")
     tunnel.join(south, target)
     tunnel.fill(lengths["tunnel"])
 

@@ -36,7 +36,7 @@ CAVERN_ON_TRUNK = (0.3, 0.7)
 #: Length of the narrow passage from the trunk to the cavern (m).
 CAVERN_NECK_M = 15.0
 #: Tries at growing the cavern (each off another trunk sample) before giving up.
-CAVERN_TRIES = 8
+CAVERN_TRIES = 16
 
 
 @dataclass

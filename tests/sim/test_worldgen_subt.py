@@ -15,7 +15,7 @@ from delve.sim import worldgen
 from delve.sim.platforms import AERIAL, LEGGED
 from delve.sim.worldgen_subt import HALL_SIZE_M, MAX_WALKABLE_SLOPE_DEG
 from delve.sim.worldgen_subt_plan import SECTIONS
-from delve.sim.worldgen_subt_urban import URBAN_LEVEL_RISE_M
+from delve.sim.worldgen_subt_urban import CORRIDOR_M, DOOR_WIDTH_M, URBAN_LEVEL_RISE_M, WALL_M
 
 #: A course of about 500 m: sections of 175, 112 and 138 m, voxels the legged step height.
 SMALL = dict(scale=0.25, voxel_size_m=0.3)
@@ -113,15 +113,20 @@ def test_the_urban_section_has_two_levels_joined_by_stairs(course):
     assert stacked >= 1
 
 
-def test_rooms_have_doors_at_full_scale_lengths():
-    world = worldgen.subt_final(2, scale=0.5, voxel_size_m=0.4)
+def test_rooms_are_dead_ends_behind_a_wall_with_a_door():
+    world = worldgen.subt_final(2, scale=0.5, voxel_size_m=0.3)
     g = world.centreline
     rooms = [(a, b) for a, b, d in g.edges(data=True) if d["kind"] == "room"]
     assert len(rooms) >= 4
     for a, b in rooms:
-        inner = b if g.degree(b) == 1 else a
+        inner, door = (b, a) if g.degree(b) == 1 else (a, b)
         assert g.degree(inner) == 1                   # a room is a dead end behind its door
-        assert world.free[voxel_above(world, inner)]
+        pi, pd = g.nodes[inner]["pos"], g.nodes[door]["pos"]
+        side = np.sign(pi[0] - pd[0])
+        wall = pd + [side * (0.5 * CORRIDOR_M + 0.5 * WALL_M), 0.0, 1.0]
+        assert world.is_free(np.array([wall, pi + [0.0, 0.0, 1.0]])).all()
+        beside = wall + [[0.0, DOOR_WIDTH_M, 0.0], [0.0, -DOOR_WIDTH_M, 0.0]]
+        assert not world.is_free(beside).any()
 
 
 def test_the_cavern_is_much_wider_than_the_passages(course):
