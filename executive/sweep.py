@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import logging
 import os
+import sys
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
@@ -24,6 +25,8 @@ from .sweep_table import plot_figures, results_table, write_table
 
 #: Seconds to wait for an existing scheduler (``--scheduler``) to answer.
 CONNECT_TIMEOUT_S = 10
+#: Exit status of a sweep stopped by Ctrl-C (128 + SIGINT, as a shell reports it).
+INTERRUPTED = 130
 
 
 @dataclass
@@ -34,7 +37,6 @@ class SweepResult:
     ran: int
     failed: int
     table: Any
-    files: list[Path]
 
 
 def default_workers() -> int:
@@ -93,11 +95,11 @@ def run_sweep(sweep: Sweep, out: Path, *, workers: int | None = None, scheduler:
                 if progress is not None:
                     progress(done, len(todo), spec, record)
     table = results_table(sweep, records, runs_dir)
-    files = write_table(table, out)
+    write_table(table, out)
     if plots:
-        files += plot_figures(table, sweep, out / "plots")
+        plot_figures(table, sweep, out / "plots")
     failed = int((table["status"] != "ok").sum())
-    return SweepResult(skipped=skipped, ran=len(todo), failed=failed, table=table, files=files)
+    return SweepResult(skipped=skipped, ran=len(todo), failed=failed, table=table)
 
 
 @contextmanager
@@ -128,7 +130,7 @@ def progress_bar(name: str) -> Iterator[Callable[[int, int, RunSpec, dict], None
 def sweep_command(path: Path, out: Path | None, workers: int | None, scheduler: str | None, quiet: bool,
                   retry_failed: bool, include_path: tuple[Path, ...]) -> int:
     """The ``delve sweep`` command: check, run, write; exit 0 when every run ran, 1
-    when one failed."""
+    when one failed, :data:`INTERRUPTED` on Ctrl-C."""
     from .sweep_spec import load_sweep
 
     if workers is not None and workers < 1:
@@ -137,9 +139,14 @@ def sweep_command(path: Path, out: Path | None, workers: int | None, scheduler: 
         raise DelveError("--workers sizes the local cluster: leave it out with --scheduler")
     sweep = load_sweep(path, include_path)
     out = out or Path("delve-out") / sweep.name
-    with (_no_bar() if quiet else progress_bar(sweep.name)) as progress:
-        result = run_sweep(sweep, out, workers=workers, scheduler=scheduler, retry_failed=retry_failed,
-                           progress=progress)
+    try:
+        with (_no_bar() if quiet else progress_bar(sweep.name)) as progress:
+            result = run_sweep(sweep, out, workers=workers, scheduler=scheduler, retry_failed=retry_failed,
+                               progress=progress)
+    except KeyboardInterrupt:
+        print(f"sweep {sweep.name}: interrupted; the same command resumes it (finished runs are kept)",
+              file=sys.stderr)
+        return INTERRUPTED
     print(f"sweep {sweep.name}: {len(sweep.runs)} runs, {result.ran} run now, {result.skipped} finished before, "
           f"{result.failed} failed")
     for _, row in result.table[result.table["status"] != "ok"].iterrows():

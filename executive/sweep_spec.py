@@ -140,7 +140,7 @@ def load_sweep(path: str | Path, include_path: tuple[Path, ...] = ()) -> Sweep:
                 except DelveError as err:
                     raise DelveError(err.message, path, err.line) from None
                 checked = _generated(file, docs[file], overrides, (path, file_line), include_path)
-                for seed in [s for s, _ in seeds] or [checked.seed]:
+                for seed in seeds or [checked.seed]:
                     runs.append(RunSpec(
                         run_id=run_id(checked.name, label, fixed, tuple(combo), seed), scenario_file=file,
                         scenario=checked.name, seed=seed, overrides=overrides, label=label,
@@ -209,9 +209,9 @@ def _scenario_file(item: Any, path: Path, line: int | None, where: str) -> tuple
     return file, line
 
 
-def _seeds(doc: YamlDict, path: Path) -> list[tuple[int, int | None]]:
-    """The ``seeds:`` with their lines: a list of integers >= 0, or ``{count, first}``;
-    empty when the key is absent (each scenario's own seed)."""
+def _seeds(doc: YamlDict, path: Path) -> list[int]:
+    """The ``seeds:``: a list of integers >= 0, or ``{count, first}``; empty when the
+    key is absent (each scenario's own seed)."""
     given = doc.get("seeds")
     line = doc.key_line("seeds")
     if given is None:
@@ -223,7 +223,7 @@ def _seeds(doc: YamlDict, path: Path) -> list[tuple[int, int | None]]:
             if isinstance(value, bool) or not isinstance(value, int) or value < low:
                 raise DelveError(f"seeds: {key} must be an integer >= {low}, not {short_repr(value)}", path,
                                  given.key_line(key))
-        return [(first + i, line) for i in range(count)]
+        return [first + i for i in range(count)]
     if not isinstance(given, list) or not given:
         raise DelveError("seeds: a non-empty list of integers, or {count: N, first: S}", path, line)
     seeds = []
@@ -231,9 +231,9 @@ def _seeds(doc: YamlDict, path: Path) -> list[tuple[int, int | None]]:
         at = given.item_line(i) if isinstance(given, YamlList) else line
         if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
             raise DelveError(f"seeds/{i}: a seed is an integer >= 0, not {short_repr(seed)}", path, at)
-        if seed in (s for s, _ in seeds):
+        if seed in seeds:
             raise DelveError(f"seeds/{i}: seed {seed} is given twice", path, at)
-        seeds.append((seed, at))
+        seeds.append(seed)
     return seeds
 
 

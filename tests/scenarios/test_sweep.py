@@ -1,6 +1,6 @@
 """A sweep of four tiny runs on a two-worker LocalCluster: its table and plots, a
-resume after an interruption, a failing run beside good ones, and reports equal to
-``delve run``'s for the same scenario and seed."""
+resume after an interruption (on a cluster given by its address), a failing run
+beside good ones, and reports equal to ``delve run``'s for the same scenario and seed."""
 import json
 import os
 import subprocess
@@ -9,6 +9,7 @@ from pathlib import Path
 
 import pandas as pd
 import pytest
+from dask.distributed import LocalCluster
 
 from delve import TREES_DIR
 from delve.executive.cli import main
@@ -72,7 +73,10 @@ def test_a_second_start_runs_only_what_is_unfinished_and_a_failure_stops_nothing
     kept = {r.run_id: (runs / r.run_id / "report.json").stat().st_mtime_ns for r in sweep.runs}
     # A second entry whose world cannot be built (too short for a loop) fails at build, on every seed and range.
     (folder / "s.yaml").write_text(GRID + "runs:\n  - {}\n  - {label: broken, set: {world.total_length_m: 60}}\n")
-    assert main(["sweep", str(folder / "s.yaml"), "--out", str(folder / "out"), "--workers", "2", "--quiet"]) == 1
+    # This time on an existing cluster, given by its address.
+    with LocalCluster(n_workers=2, threads_per_worker=1, dashboard_address=None) as cluster:
+        assert main(["sweep", str(folder / "s.yaml"), "--out", str(folder / "out"), "--scheduler",
+                     cluster.scheduler_address, "--quiet"]) == 1
     printed = capsys.readouterr().out
     assert "8 runs, 5 run now, 3 finished before, 4 failed" in printed
     after = {r: (runs / r / "report.json").stat().st_mtime_ns for r in kept}
