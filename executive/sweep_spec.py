@@ -23,6 +23,7 @@ import copy
 import hashlib
 import itertools
 import json
+import math
 import re
 import warnings
 from dataclasses import dataclass
@@ -37,6 +38,9 @@ from .yamlio import YamlDict, YamlList, load_yaml, plain
 KEYS = ("name", "scenarios", "seeds", "grid", "runs")
 RUN_KEYS = ("label", "scenario", "set")
 SEED_KEYS = ("count", "first")
+#: Most runs one sweep may make: at a minute a run, a week of a 64-core machine; more
+#: is a typo (``count: 1000000``) that would fill the disk with run folders.
+MAX_RUNS = 10_000
 #: Longest run id (a folder name); a longer one is cut and ends in a digest of the whole.
 MAX_ID_CHARS = 120
 #: Characters of a run id besides letters and digits; any other becomes ``_``.
@@ -123,11 +127,15 @@ def load_sweep(path: str | Path, include_path: tuple[Path, ...] = ()) -> Sweep:
     if not isinstance(name, str) or not name:
         raise DelveError(f"name: must be a non-empty string, not {short_repr(name)}", path, doc.key_line("name"))
     seeds, grid = _seeds(doc, path), _grid(doc, path)
+    entries = _run_entries(doc, path, _scenario_files(doc, path))
+    total = sum(len(files) for _, files, _ in entries) * math.prod(map(len, grid)) * max(1, len(seeds))
+    if total > MAX_RUNS:
+        raise DelveError(f"sweep: {total:,} runs, more than the limit of {MAX_RUNS:,}", path, doc.line)
     runs: list[RunSpec] = []
     docs: dict[Path, YamlDict] = {}
     with warnings.catch_warnings(record=True) as shown:
         warnings.simplefilter("always")
-        for label, files, fixed in _run_entries(doc, path, _scenario_files(doc, path)):
+        for label, files, fixed in entries:
             for (file, file_line), combo in itertools.product(files, itertools.product(*grid)):
                 overrides = fixed + tuple(combo)
                 seeded = [o for o in overrides if o.path == "seed"]
@@ -190,14 +198,12 @@ def _known_keys(doc: YamlDict, allowed: tuple[str, ...], where: str, path: Path)
 
 def _scenario_files(doc: YamlDict, path: Path) -> list[tuple[Path, int | None]]:
     """The ``scenarios:`` files, relative to the sweep file, with their lines."""
-    given = doc.get("scenarios", [])
-    if isinstance(given, str):
-        given = YamlList([given], line=doc.key_line("scenarios"))
-        given._item_lines = [doc.key_line("scenarios")]
-    if not isinstance(given, list):
-        raise DelveError("scenarios: must be a list of scenario files", path, doc.key_line("scenarios"))
-    return [_scenario_file(item, path, given.item_line(i) if isinstance(given, YamlList) else None, "scenarios")
-            for i, item in enumerate(given)]
+    given, line = doc.get("scenarios", []), doc.key_line("scenarios")
+    items = [given] if isinstance(given, str) else given
+    if not isinstance(items, list):
+        raise DelveError("scenarios: must be a list of scenario files", path, line)
+    return [_scenario_file(item, path, items.item_line(i) if isinstance(items, YamlList) else line, "scenarios")
+            for i, item in enumerate(items)]
 
 
 def _scenario_file(item: Any, path: Path, line: int | None, where: str) -> tuple[Path, int | None]:
@@ -219,9 +225,10 @@ def _seeds(doc: YamlDict, path: Path) -> list[int]:
     if isinstance(given, dict):
         _known_keys(given, SEED_KEYS, "seeds", path)
         count, first = given.get("count"), given.get("first", 1)
-        for key, value, low in (("count", count, 1), ("first", first, 0)):
-            if isinstance(value, bool) or not isinstance(value, int) or value < low:
-                raise DelveError(f"seeds: {key} must be an integer >= {low}, not {short_repr(value)}", path,
+        for key, value, low, high in (("count", count, 1, MAX_RUNS), ("first", first, 0, math.inf)):
+            if isinstance(value, bool) or not isinstance(value, int) or not low <= value <= high:
+                span = f"from {low} to {high}" if high < math.inf else f">= {low}"
+                raise DelveError(f"seeds: {key} must be an integer {span}, not {short_repr(value)}", path,
                                  given.key_line(key))
         return [first + i for i in range(count)]
     if not isinstance(given, list) or not given:
