@@ -8,7 +8,7 @@ from .errors import did_you_mean
 
 
 #: Top-level keys that only a scenario has (a tree node may have a name too).
-_SCENARIO_ONLY_KEYS = ("world", "robots", "base_station", "radio", "team", "supervisor", "faults")
+_SCENARIO_ONLY_KEYS = ("world", "robots", "base_station", "radio", "team", "supervisor", "faults", "artifacts")
 
 
 def scenario_keys(mapping: Any) -> list[str]:

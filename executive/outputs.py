@@ -1,4 +1,5 @@
-"""What a run writes: report.json, log.jsonl, map.png, coverage.png and tree dumps."""
+"""What a run writes: report.json, log.jsonl, map.png, coverage.png, scored.png (with
+artifacts) and tree dumps."""
 from __future__ import annotations
 
 import json
@@ -77,6 +78,7 @@ def report(mission: Mission, wall_time_s: float) -> dict[str, Any]:
                                for f in COVERAGE_MILESTONES},
         **mission.backend.figures(mission),
         **mission.team.figures(mission),
+        **mission.artifacts.figures(mission),
         "robots": robots,
         **mission.team.wall_clock_figures(mission),
     }
@@ -114,6 +116,7 @@ def write_outputs(mission: Mission, out: Path, wall_time_s: float) -> dict[str, 
             f.write(json.dumps(e, sort_keys=False) + "\n")
     mission.backend.plot_map(mission, out / "map.png")
     plot_coverage(mission, out / "coverage.png", mission.backend.COVERAGE_LABEL)
+    mission.artifacts.write_plots(mission, out)
     for name, agent in mission.agents.items():
         render_tree(agent.root, "txt", out / f"tree_{name}.txt")
         render_tree(agent.root, "svg", out / f"tree_{name}.svg")

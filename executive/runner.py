@@ -21,6 +21,7 @@ from ..sim.clock import SimClock
 from ..skills.base import AgentContext
 from ..skills.operator import COMMAND
 from .agent import Agent
+from .artifacts import NoArtifacts, artifact_course
 from .faults import FaultSchedule
 from .outcome import Outcome, mission_outcome
 from .scenario import Scenario
@@ -67,6 +68,9 @@ class Mission:
         self.state = MissionState()
         self.backend: WorldBackend = scenario.world_backend(scenario, world, self.seed, self.clock)
         self.team = scenario.team_strategy()
+        self.artifacts: NoArtifacts = artifact_course(scenario, self.world, self.robots,
+                                                      next(iter(self.robots.values())).home, self.seed, self.clock,
+                                                      self.duration_s, self.log)
         self.agents: dict[str, Agent] = {}
         self._commands = deque(scenario.supervisor)
         self.faults = FaultSchedule(scenario.faults)
@@ -107,6 +111,7 @@ class Mission:
             ctx = self._context(BASE, None)
             ctx.services.update(self.backend.base_services())
             ctx.services.update(self.team.base_services())
+            ctx.services.update(self.artifacts.base_services())
             self.agents[BASE] = Agent(BASE, load_tree(self.scenario.base_tree, ctx,
                                                       include_path=self.scenario.include_path),
                                       1.0 / self.scenario.base_tick_hz, ctx, on_change=self._status_changed)
@@ -141,6 +146,7 @@ class Mission:
             now = self.clock.now_s
             self._supervise(now)
             self.backend.sense(now)
+            self.artifacts.sense(now)
             self.radio.update()
             for agent in self.agents.values():
                 if agent.name in self.lost:

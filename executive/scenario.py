@@ -15,6 +15,7 @@ from typing import Any, Iterable
 
 import jsonschema
 
+from .artifacts import ArtifactSetup, check_sensors
 from .errors import DelveDeprecation, DelveError, DelveWarning, did_you_mean, display_path
 from .document_kind import scenario_keys
 from .faults import Fault, FaultContext, load_faults
@@ -62,6 +63,8 @@ class RobotSpec:
     overrides: dict[str, float] = field(default_factory=dict)
     lidar: dict[str, float] = field(default_factory=dict)
     breadcrumbs: int = 0
+    #: The artifact sensors' parameters that differ from the platform's.
+    sensors: dict[str, Any] = field(default_factory=dict)
     line: int | None = None
     start_line: int | None = None
 
@@ -95,6 +98,8 @@ class Scenario:
     team: TeamSpec
     supervisor: list[Command] = field(default_factory=list)
     faults: list[Fault] = field(default_factory=list)
+    #: The artifacts the world hides and the referee's rules (``artifacts:``), or None.
+    artifacts: ArtifactSetup | None = None
     #: Folders the trees' includes may resolve into besides their own and the shipped trees.
     include_path: tuple[Path, ...] = ()
 
@@ -109,7 +114,8 @@ class Scenario:
         return self.world_backend.build_world(self, self.seed if seed is None else seed)
 
     def check_starts(self, world: Any) -> None:
-        """Each robot's start pose must be inside the world and in free space."""
+        """Each robot's start pose must be inside the world and in free space, and so
+        must each listed artifact."""
         for r in self.robots:
             if r.start is None:
                 continue
@@ -122,6 +128,8 @@ class Scenario:
             if problem:
                 raise DelveError(f"base station position is {problem}", self.path,
                                  self.doc["base_station"].key_line("position"))
+        if self.artifacts is not None:
+            self.artifacts.listed(world)
 
 
 def _where(path: Any) -> str:
@@ -288,6 +296,22 @@ def _team(doc: YamlDict, path: Path, tree_types: set[type]) -> TeamSpec:
     return TeamSpec(strategy, params)
 
 
+def _artifacts(doc: YamlDict, path: Path, backend: type[WorldBackend], tree_types: set[type]) -> ArtifactSetup | None:
+    """The scenario's ``artifacts:`` section: only on worlds that hide artifacts; a
+    warning when no tree submits reports (nothing could score)."""
+    setup = ArtifactSetup.from_scenario(doc, path)
+    if setup is None:
+        return None
+    if not backend.ARTIFACTS:
+        raise DelveError(f"artifacts: this world ({backend.__name__}) cannot hide artifacts (a voxel world can)",
+                         path, doc.key_line("artifacts"))
+    if not any(t.__name__ == "SubmitArtifacts" for t in tree_types):
+        warnings.warn(DelveWarning(f"{display_path(path)}:{doc.key_line('artifacts')}: artifacts: no tree submits "
+                                   "reports (SubmitArtifacts in the base station's tree): nothing can score"),
+                      stacklevel=2)
+    return setup
+
+
 def load_scenario(path: str | Path, include_path: Iterable[str | Path] = (),
                   doc: YamlDict | None = None) -> Scenario:
     """Read and check a scenario file (not its world: see :meth:`Scenario.build_world`).
@@ -327,7 +351,8 @@ def load_scenario(path: str | Path, include_path: Iterable[str | Path] = (),
         robots.append(RobotSpec(name=r["name"], platform=r["platform"], tree=tree, start=r.get("start"),
                                 endurance_s=r.get("endurance_s"), tick_hz=float(r.get("tick_hz", 5.0)),
                                 overrides=extra, lidar=plain(r.get("lidar", {})), breadcrumbs=r.get("breadcrumbs", 0),
-                                line=line, start_line=r.key_line("start")))
+                                sensors=check_sensors(r, i, r["platform"], path), line=line,
+                                start_line=r.key_line("start")))
 
     base = doc.get("base_station", {})
     base_tree = None
@@ -342,6 +367,7 @@ def load_scenario(path: str | Path, include_path: Iterable[str | Path] = (),
     warn_late_events(doc, path, float(values["duration_s"]))
     backend.check(doc, path, base_tree is not None)
     team = _team(doc, path, tree_types)
+    artifacts = _artifacts(doc, path, backend, tree_types)
     if team.strategy.NEEDS_BASE_TREE and base_tree is None:
         name = next(n for n, s in TEAM_STRATEGIES.items() if s is team.strategy)
         raise DelveError(f"team strategy {name!r} needs a base station tree (base_station: tree: ...)", path,
@@ -351,4 +377,4 @@ def load_scenario(path: str | Path, include_path: Iterable[str | Path] = (),
                     world=plain(doc["world"]), robots=robots, base_tree=base_tree,
                     base_position=base.get("position"), base_tick_hz=float(base.get("tick_hz", 1.0)),
                     radio=plain(doc.get("radio", {})), doc=doc, world_backend=backend, team=team, supervisor=supervisor,
-                    faults=faults, include_path=include_path)
+                    faults=faults, include_path=include_path, artifacts=artifacts)

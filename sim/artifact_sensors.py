@@ -292,6 +292,10 @@ class ArtifactSensors:
                            for yaw, pitch in zip(s.camera_yaw_deg, s.camera_pitch_deg)]
         self._of_class = {cs: np.isin(self._cls, cs) for cs in (s.visual_classes, s.thermal_classes)}
         self._due: dict[str, float] = {}
+        #: Ground truth for the report, never for the robot: each artifact's name ->
+        #: the sim time a sensor first picked it up (a true camera detection, a
+        #: Bluetooth reading, or a CO2 reading inside its gas room).
+        self.detected: dict[str, float] = {}
         self._bluetooth = np.flatnonzero(np.isin(self._cls, s.bluetooth_classes))
         # the farthest a Bluetooth signal can be read (through air, three sigma of noise)
         self._bluetooth_reach_m = 10 ** ((s.bluetooth_power_at_1m_dbm - s.bluetooth_sensitivity_dbm
@@ -332,7 +336,15 @@ class ArtifactSensors:
             out.extend(self._bluetooth_readings(t_s, trans))
         if len(self._gas) and self._frame_due("co2", t_s, s.co2_rate_hz):
             out.append(SignalReading(float(t_s), "co2", None, trans.copy(), self.co2_ppm(trans)))
+            self._note_gas_room(t_s, trans)
         return out
+
+    def _note_gas_room(self, t_s: float, sensor: np.ndarray) -> None:
+        """Record the gas artifact whose room the sensor stands in (the nearest one)."""
+        g = float(self._co2_grid.at(self._co2_field, sensor[None])[0])
+        if g <= self.spec.co2_room_radius_m:
+            i = self._gas[int(np.argmin(np.linalg.norm(self._pos[self._gas] - sensor, axis=1)))]
+            self.detected.setdefault(self.artifacts[int(i)].name, float(t_s))
 
     def _cameras_due(self, t_s: float, rot: np.ndarray, trans: np.ndarray,
                      payload: PanTiltZoomCamera | None) -> list[_Camera]:
@@ -399,6 +411,7 @@ class ArtifactSensors:
             if rng.random() >= self.detection_probability(cam, int(i)):
                 continue
             a = self.artifacts[int(i)]
+            self.detected.setdefault(a.name, float(t_s))
             label = a.artifact_class
             others = [c for c in cam.classes if c != label]
             if others and rng.random() < s.misclassification_probability:
@@ -470,8 +483,11 @@ class ArtifactSensors:
         if len(near) == 0:
             return []
         values = self.bluetooth_dbm(sensor, near) + self.rng.normal(0.0, s.bluetooth_noise_db, len(near))
-        return [SignalReading(float(t_s), "bluetooth", self.artifacts[int(i)].name, sensor.copy(), float(v))
-                for i, v in zip(near, values) if v >= s.bluetooth_sensitivity_dbm]
+        out = [SignalReading(float(t_s), "bluetooth", self.artifacts[int(i)].name, sensor.copy(), float(v))
+               for i, v in zip(near, values) if v >= s.bluetooth_sensitivity_dbm]
+        for r in out:
+            self.detected.setdefault(r.identifier, float(t_s))
+        return out
 
     def co2_ppm(self, sensor: np.ndarray, noise: bool = True) -> float:
         """CO2 concentration (ppm) at ``sensor``: the room's level within its radius of a

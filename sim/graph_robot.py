@@ -135,6 +135,13 @@ class GraphRobot(RobotBody):
     def payload(self) -> None:
         return None
 
+    def take_camera_detections(self) -> list:
+        """No artifact sensors on a graph world."""
+        return []
+
+    def take_signal_readings(self) -> list:
+        return []
+
     # ---- NetworkView --------------------------------------------------------------
     def topology(self) -> dict[str, Any]:
         """What this robot explored so far, as a plain topology dict."""

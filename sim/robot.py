@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .artifact_sensors import CameraDetection, SignalReading
 from .body import RobotBody
 from .payload import PanTiltZoomCamera
 from .platforms import Platform
@@ -78,6 +79,8 @@ class SimRobot(RobotBody):
         self._status = IDLE
         self.blocked_reason = ""
         self._scans = 0
+        self._detections: list[CameraDetection] = []
+        self._signals: list[SignalReading] = []
         self._commands = 0
 
         self._stuck_s = 0.0
@@ -150,6 +153,20 @@ class SimRobot(RobotBody):
         if self._payload is None and not self._platform.aerial:
             self._payload = PanTiltZoomCamera(self.world)
         return self._payload
+
+    # ---- artifact sensors (their readings come from the mission's ArtifactSensors) ----
+    def receive_artifact_readings(self, readings: list) -> None:
+        """Keep the artifact sensors' new readings for the fusion behaviours."""
+        for r in readings:
+            (self._detections if isinstance(r, CameraDetection) else self._signals).append(r)
+
+    def take_camera_detections(self) -> list[CameraDetection]:
+        out, self._detections = self._detections, []
+        return out
+
+    def take_signal_readings(self) -> list[SignalReading]:
+        out, self._signals = self._signals, []
+        return out
 
     @property
     def alive(self) -> bool:

@@ -245,16 +245,31 @@ class Mailbox:
     def __init__(self, radio: Any):
         self.radio = radio
         self.queues: dict[str, deque[Any]] = {}
+        #: Kinds that some behaviour takes by name (see :meth:`take_unclaimed`).
+        self.claimed: set[str] = set()
+
+    def claim(self, kind: str) -> None:
+        """Say, when a behaviour is built, that it takes messages of ``kind``."""
+        self.claimed.add(kind)
 
     def take(self, kind: str) -> list[Any]:
         """The messages of ``kind`` delivered and not yet taken, oldest first."""
-        for msg in self.radio.receive():
-            self.queues.setdefault(msg.kind, deque(maxlen=MAILBOX_LIMIT)).append(msg)
+        self._sort()
         queue = self.queues.get(kind)
         out = list(queue) if queue else []
         if queue:
             queue.clear()
         return out
+
+    def take_unclaimed(self) -> list[Any]:
+        """The messages of every kind no behaviour claimed, in kind order then oldest
+        first (for a behaviour that logs what nobody else handles)."""
+        self._sort()
+        return [msg for kind in sorted(self.queues) if kind not in self.claimed for msg in self.take(kind)]
+
+    def _sort(self) -> None:
+        for msg in self.radio.receive():
+            self.queues.setdefault(msg.kind, deque(maxlen=MAILBOX_LIMIT)).append(msg)
 
 
 def mailbox(ctx: AgentContext, radio: Any) -> Mailbox:

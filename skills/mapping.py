@@ -5,7 +5,7 @@ from typing import Any
 
 from py_trees.common import Status
 
-from .base import Param, Skill
+from .base import Param, Skill, mailbox
 
 MAP_DELTA = "map_delta"
 
@@ -46,18 +46,23 @@ class ShareMap(Skill):
 
 class MergeMaps(Skill):
     """Base station: merge every map delta that arrives into the base map; log every
-    other message (reports for the supervisor) as a ``base_received`` event.
+    message of a kind no other behaviour takes (reports for the supervisor) as a
+    ``base_received`` event.
 
     Reads services ``radio`` and ``map`` of the base station's agent.
     Returns RUNNING (it is a background task).
     """
 
+    def __init__(self, name: str, ctx: Any, remap: dict[str, str] | None = None, **params: Any):
+        super().__init__(name, ctx, remap, **params)
+        if "radio" in ctx.services:  # not when a tree is only checked
+            mailbox(ctx, ctx.services["radio"]).claim(MAP_DELTA)
+
     def update(self) -> Status:
-        radio, base_map = self.ctx.services["radio"], self.ctx.services["map"]
-        for msg in radio.receive():
-            if msg.kind == MAP_DELTA:
-                base_map.merge(msg.data["flat"], msg.data["values"])
-            else:
-                self.event("base_received", sender=msg.sender, kind=msg.kind, data=msg.data, sent_s=msg.sent_s)
+        box, base_map = mailbox(self.ctx, self.ctx.services["radio"]), self.ctx.services["map"]
+        for msg in box.take(MAP_DELTA):
+            base_map.merge(msg.data["flat"], msg.data["values"])
+        for msg in box.take_unclaimed():
+            self.event("base_received", sender=msg.sender, kind=msg.kind, data=msg.data, sent_s=msg.sent_s)
         return Status.RUNNING
 

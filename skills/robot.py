@@ -99,6 +99,31 @@ class Radio(Protocol):
         no route exists. Each call is one attempt (it may fail on a working link)."""
 
 
+class CameraDetection(Protocol):
+    """One object detection in one camera frame: when, which camera, the detector's
+    label and confidence (0..1), the camera's optical centre (3,) and (K, 3) unit rays
+    through the pixels of the detection's bounding box, in the world frame."""
+
+    t_s: float
+    camera: str
+    artifact_class: str
+    confidence: float
+    origin: np.ndarray
+    rays: np.ndarray
+
+
+class SignalReading(Protocol):
+    """One reading of a signal sensor: ``kind`` ``bluetooth`` (``value`` in dBm, the
+    beacon's SSID as ``identifier``) or ``co2`` (ppm, no identifier), taken at
+    ``position`` (3,) at ``t_s``."""
+
+    t_s: float
+    kind: str
+    identifier: str | None
+    position: np.ndarray
+    value: float
+
+
 class BreadcrumbDrop(Protocol):
     """The result of a breadcrumb drop: ``ok`` and the new relay's ``name``, or an
     ``error`` saying why not (no breadcrumbs left, ...); ``remaining`` after it."""
@@ -256,6 +281,12 @@ class Robot(Protocol):
     @property
     def payload(self) -> Payload | None:
         """The pan-tilt-zoom inspection camera; None when the robot carries none."""
+
+    def take_camera_detections(self) -> list[CameraDetection]:
+        """The artifact detector's detections since the last call, oldest first."""
+
+    def take_signal_readings(self) -> list[SignalReading]:
+        """The Bluetooth and CO2 readings since the last call, oldest first."""
 
 
 class NetworkView(Protocol):

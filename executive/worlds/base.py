@@ -80,6 +80,8 @@ class WorldBackend(ABC):
     #: Fault kinds this world cannot inject (``faults:`` in a scenario; a fault kind
     #: may also name the worlds it applies to, ``Fault.WORLDS``).
     UNSUPPORTED_FAULTS: ClassVar[tuple[str, ...]] = ()
+    #: Whether a scenario on this world may hide artifacts (``artifacts:``).
+    ARTIFACTS: ClassVar[bool] = False
 
     world: Any
     robots: dict[str, Any]

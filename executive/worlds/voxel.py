@@ -44,6 +44,7 @@ class VoxelBackend(WorldBackend):
 
     KEYS = ("generator", "mesh")
     COVERAGE_LABEL = "fraction of free volume observed"
+    ARTIFACTS = True
 
     @classmethod
     def generators(cls) -> dict[str, Any]:

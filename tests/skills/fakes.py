@@ -171,6 +171,9 @@ class FakeRobot:
         self.has_ground = True
         self.drops: list[np.ndarray] = []
         self.map_resets: list[float] = []
+        #: Artifact readings the next take_* call returns (tests fill them).
+        self.camera_detections: list = []
+        self.signal_readings: list = []
 
     @property
     def position(self) -> np.ndarray:
@@ -189,6 +192,14 @@ class FakeRobot:
     @property
     def command_id(self) -> int:
         return len(self.paths) + self.stops
+
+    def take_camera_detections(self) -> list:
+        out, self.camera_detections = self.camera_detections, []
+        return out
+
+    def take_signal_readings(self) -> list:
+        out, self.signal_readings = self.signal_readings, []
+        return out
 
     def follow_path(self, path) -> None:
         self.path = np.asarray(path, float).reshape(-1, 3)
