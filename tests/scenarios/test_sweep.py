@@ -74,7 +74,7 @@ def test_a_second_start_runs_only_what_is_unfinished_and_a_failure_stops_nothing
     # A second entry whose world cannot be built (too short for a loop) fails at build, on every seed and range.
     (folder / "s.yaml").write_text(GRID + "runs:\n  - {}\n  - {label: broken, set: {world.total_length_m: 60}}\n")
     # This time on an existing cluster, given by its address.
-    with LocalCluster(n_workers=2, threads_per_worker=1, dashboard_address=None) as cluster:
+    with LocalCluster(n_workers=2, threads_per_worker=1, dashboard_address=":0") as cluster:
         assert main(["sweep", str(folder / "s.yaml"), "--out", str(folder / "out"), "--scheduler",
                      cluster.scheduler_address, "--quiet"]) == 1
     printed = capsys.readouterr().out
