@@ -60,22 +60,25 @@ class NavGraph:
 
 
 class _Lookup:
-    """A reusable flat-index -> node-id array, reset after each use (O(nodes), not O(grid))."""
+    """A reusable flat-index -> node id + 1 array (0: no node), reset after each use
+    (O(nodes), not O(grid)). It starts zero-filled, so the operating system backs only
+    the pages that ever held a node: on a large world it costs memory where the map
+    has free voxels, not 4 bytes for every voxel of the grid."""
 
     _buffers: dict[int, np.ndarray] = {}
 
     def __init__(self, size: int, flat: np.ndarray):
         buf = self._buffers.get(size)
         if buf is None:
-            buf = self._buffers[size] = np.full(size, -1, dtype=np.int64)
+            buf = self._buffers[size] = np.zeros(size, dtype=np.int32)
         self.buf, self.flat = buf, flat
-        buf[flat] = np.arange(len(flat))
+        buf[flat] = np.arange(1, len(flat) + 1)
 
     def __enter__(self) -> np.ndarray:
         return self.buf
 
     def __exit__(self, *exc: object) -> None:
-        self.buf[self.flat] = -1
+        self.buf[self.flat] = 0
 
 
 class Voxels:
@@ -223,7 +226,7 @@ def _inclination_deg(cand: Voxels, vox: float, limit_deg: float, baseline_m: flo
         for di, dj in ((b, 0), (-b, 0), (0, b), (0, -b)):
             h = np.full(len(cand), np.nan)
             for dz in sorted(range(-search, search + 1), key=abs):
-                hit = (cand.at(ids, (di, dj, dz), -1) >= 0) & np.isnan(h)
+                hit = (cand.at(ids, (di, dj, dz), 0) > 0) & np.isnan(h)
                 h[hit] = dz
             heights[(di, dj)] = h
     grads = []
@@ -276,11 +279,11 @@ def _graph(nodes: Voxels, positions: np.ndarray, offsets: list[tuple[int, int, i
         def beside(di: int, dj: int) -> np.ndarray:
             if (di, dj) not in sides:
                 sides[(di, dj)] = np.logical_or.reduce(
-                    [nodes.at(ids, (di, dj, dz), -1) >= 0 for dz in range(-side_steps, side_steps + 1)])
+                    [nodes.at(ids, (di, dj, dz), 0) > 0 for dz in range(-side_steps, side_steps + 1)])
             return sides[(di, dj)]
 
         for d in offsets:
-            tgt = nodes.at(ids, d, -1)
+            tgt = nodes.at(ids, d, 0).astype(np.int64) - 1
             ok = tgt >= 0
             if side_steps is not None and d[0] and d[1]:
                 ok &= beside(d[0], 0) & beside(0, d[1])
