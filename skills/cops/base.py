@@ -12,6 +12,9 @@ from ..base import AgentContext, Param, ParamNamedPort, Skill
 from ..robot import NetworkView, PathStatus
 from .state import KIND, CopsState, collect_own_map
 
+#: A route towards where the knowledge puts a location that ends nearer the robot
+#: than this (m) takes it no nearer: it is there as far as its own map can tell.
+HINT_PROGRESS_M = 1.0
 STATE_KEY = Param(str, "cops", "blackboard key of the agent's COPS state", key=True)
 #: The agent's COPS state as the behaviours read it (a fresh one while none is stored)...
 STATE_IN = ParamNamedPort(CopsState, required=False, description="the agent's COPS state (a fresh one while none "
@@ -94,6 +97,9 @@ class CopsSkill(Skill):
             return None
         if not on_own_route or robot.path_status in (PathStatus.ARRIVED, PathStatus.IDLE):
             route = view.route(there) if hint is None else view.route_towards(hint)
+            if hint is not None and route is not None and \
+                    np.linalg.norm(np.asarray(route)[-1] - robot.position) < HINT_PROGRESS_M:
+                route, inside = None, True  # its own map takes it no nearer
             if route is None and inside:  # as near as it gets
                 self._driving, self._settled = None, there
                 return None

@@ -147,26 +147,30 @@ class VoxelNetworkView:
         """Waypoints (N, 3) along the navigation graph from the robot to the node nearest
         the location's position or, when the graph does not reach it yet, to the
         reachable node nearest it (if that is ``MIN_PROGRESS_M`` nearer than the robot),
-        else straight to it if the straight line crosses only known free space; None
-        for an unknown location or when none of these is possible."""
+        else, from outside the location, straight to it if the straight line crosses
+        only known free space; None for an unknown location or when none of these is
+        possible (inside the location: the robot is as near as it gets)."""
         pos = self.target(location)
-        return None if pos is None else self.route_towards(pos)
+        if pos is None:
+            return None
+        return self.route_towards(pos, straight=self.location() != self.resolve(location))
 
-    def route_towards(self, ground: np.ndarray) -> np.ndarray | None:
-        """As :meth:`route`, to a ground point: a location the team knows and this
-        robot's map does not show yet (another robot explored it)."""
+    def route_towards(self, ground: np.ndarray, straight: bool = True) -> np.ndarray | None:
+        """As :meth:`route`, to a ground point (a location the team knows and this
+        robot's map does not show yet: another robot explored it); ``straight``
+        allows the straight route."""
         goal = np.asarray(ground, dtype=float) + [0.0, 0.0, self.sight_height_m()]
         plan, target = self._plan_towards(goal, force=False)
         if target is None and self.navigator.map_changed():
             plan, target = self._plan_towards(goal, force=True)
         if plan is None:
-            return self._straight(goal)
+            return self._straight(goal) if straight else None
         if target is None:
             reachable = np.flatnonzero(np.isfinite(plan.distances))
             gap = np.linalg.norm(plan.graph.positions[reachable] - goal, axis=1)
             target = int(reachable[np.argmin(gap)])
             if gap.min() > np.linalg.norm(np.asarray(self.robot.position) - goal) - MIN_PROGRESS_M:
-                return self._straight(goal)
+                return self._straight(goal) if straight else None
         return plan.path_to(target)
 
     def _straight(self, goal: np.ndarray) -> np.ndarray | None:
