@@ -479,8 +479,15 @@ class ShortSightedWalker(RegionWalker):
     def resolve(self, name: str) -> str | None:
         return name if int(name[1:]) < 4 else None
 
-    def route_towards(self, point) -> list[float]:
-        return [float(point[0])]
+    @property
+    def position(self) -> np.ndarray:
+        return np.array([float(self.at), 0.0, 0.0])
+
+    def route_towards(self, point) -> np.ndarray:
+        return np.array([[float(point[0]), 0.0, 0.0]])
+
+    def follow_path(self, path) -> None:
+        super().follow_path([np.asarray(path, dtype=float)[-1][0]])
 
     def near(self, point) -> bool:
         return abs(self.at - point[0]) < 0.5
