@@ -1,6 +1,8 @@
 """Nearest-frontier exploration, the baseline that GBPlanner2 is compared against.
 
-Frontier voxels are known-free voxels next to unknown ones. They are clustered, each
+Frontier voxels are known-free voxels next to unknown ones; those that the robot's
+sensor can observe from no place it can reach are left out (:func:`observable_frontiers`,
+issue 16 item 7: a narrow LiDAR and the roof of a drift). They are clustered, each
 cluster gets the navigation node nearest to it as its goal, and the cluster whose
 goal is nearest along the navigation graph is chosen. Clusters whose goal failed
 (unreachable, or still a frontier after a visit) are blacklisted by the caller.

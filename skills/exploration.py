@@ -7,8 +7,9 @@ import numpy as np
 from py_trees.common import Status
 from py_trees.ports import PortInformation
 
-from ..planners.frontier import (MAX_GOAL_OFFSET_M, VIEWPOINT_SPACING_M, FrontierCluster, FrontierGoal, frontier_clusters,
-                                 frontier_voxels, nearest_frontier, observable_frontiers, viewpoint_nodes)
+from ..planners.frontier import (MAX_GOAL_OFFSET_M, VIEWPOINT_SPACING_M, FrontierCluster, FrontierGoal,
+                                 frontier_clusters, frontier_voxels, nearest_frontier, observable_frontiers,
+                                 viewpoint_nodes)
 from ..planners.occupancy import Grid
 from ..planners.geometry import xyz
 from .base import Param, Skill
@@ -22,8 +23,9 @@ class ExploreFrontiers(Skill):
     Frontier voxels (known free next to unknown) of the onboard map that the robot's
     LiDAR could observe from a node it can reach (within its view up, with a clear
     line) are clustered; the cluster whose goal node is nearest along the navigation
-    graph is chosen and the robot follows the path to it. The voxels of a cluster that is still a frontier after a visit, or
-    whose path is blocked, are blacklisted: never goals again.
+    graph is chosen and the robot follows the path to it. The voxels of a cluster that
+    is still a frontier after a visit, or whose path is blocked, are blacklisted: never
+    goals again.
 
     Writes: ``frontier_goal`` (x, y, z of the current goal), ``frontiers_left`` (clusters).
     Returns: RUNNING while exploring; SUCCESS when no reachable frontier is left;
@@ -37,7 +39,8 @@ class ExploreFrontiers(Skill):
         "cluster_radius_m": Param(float, 0.8, "frontier blocks (2×2×2 voxels) closer than this join", exclusive_minimum=0),
         "min_cluster_voxels": Param(int, 10, "smaller clusters are ignored", minimum=1),
         "max_cluster_extent_m": Param(float, 4.0, "larger clusters are split", exclusive_minimum=0),
-        "max_goal_offset_m": Param(float, MAX_GOAL_OFFSET_M, "a goal node is at most this far from its cluster", exclusive_minimum=0),
+        "max_goal_offset_m": Param(float, MAX_GOAL_OFFSET_M, "a goal node is at most this far from its cluster",
+                                   exclusive_minimum=0),
         "observe_radius_m": Param(float, 3.0, "a frontier this near that stays one is unobservable",
                                   exclusive_minimum=0),
         "check_period_s": Param(

@@ -32,10 +32,12 @@ def frontiers_left(mission: "Mission", name: str) -> np.ndarray:
     m = robot.onboard_map
     grid = Grid(m.occupancy, m.origin, m.voxel_size_m)
     front = frontier_voxels(grid)
-    plan = navigator(mission.agents[name].ctx, robot).from_robot(force=True) if name in mission.agents else None
+    agent = mission.agents.get(name)
+    plan = navigator(agent.ctx, robot).from_robot(force=True) if agent is not None else None
     if plan is not None:
         views = plan.graph.positions[viewpoint_nodes(plan.graph, plan.distances, VIEWPOINT_SPACING_M)]
-        front = observable_frontiers(grid, front, views, view_up_deg=robot.view_up_deg, reach_m=MAX_GOAL_OFFSET_M)
+        front = observable_frontiers(grid, front, views, view_up_deg=robot.view_up_deg,
+                                     reach_m=MAX_GOAL_OFFSET_M)
     return grid.to_world(np.stack(np.unravel_index(front, m.shape), axis=1))
 
 
@@ -69,7 +71,6 @@ def plot_voxel_map(mission: "Mission", truth_voxels: np.ndarray, path: Path) -> 
         linked = np.array([s.linked[name] for s in mission.state.samples])
         ax.plot(pos[linked, 0], pos[linked, 1], "o", ms=3, color="green", label="radio link to base" if i == 0 else None)
     ax.plot(*mission.base_position[:2], "k^", ms=9, label="base station")
-    mission.artifacts.draw(ax, mission)
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
     ax.set_title(f"{mission.scenario.name}: team coverage {mission.state.samples[-1].team:.0%}")

@@ -1,7 +1,7 @@
 import numpy as np
 
-from delve.planners.frontier import (frontier_clusters, frontier_voxels, nearest_frontier, observable_frontiers,
-                                    viewpoint_nodes)
+from delve.planners.frontier import (frontier_clusters, frontier_voxels, nearest_frontier,
+                                    observable_frontiers, viewpoint_nodes)
 from delve.planners.navgraph import legged_graph
 from delve.planners.occupancy import FREE, OCCUPIED, UNKNOWN, Grid
 
