@@ -106,7 +106,8 @@ class Mission:
             ctx = self._context(spec.name, self.robots[spec.name])
             ctx.services.update(self.team.robot_services(spec.name))
             tree = load_tree(spec.tree, ctx, include_path=self.scenario.include_path)
-            self.agents[spec.name] = Agent(spec.name, tree, 1.0 / spec.tick_hz, ctx, on_change=self._status_changed)
+            self.agents[spec.name] = Agent(spec.name, tree, 1.0 / spec.tick_hz, ctx, on_change=self._status_changed,
+                                           next_tick_s=spec.deploy_at_s)
         if self.scenario.base_tree is not None:
             ctx = self._context(BASE, None)
             ctx.services.update(self.backend.base_services())

@@ -65,6 +65,8 @@ class RobotSpec:
     breadcrumbs: int = 0
     #: The artifact sensors' parameters that differ from the platform's.
     sensors: dict[str, Any] = field(default_factory=dict)
+    #: Sim time its tree starts ticking (until then it stands at its start).
+    deploy_at_s: float = 0.0
     line: int | None = None
     start_line: int | None = None
 
@@ -351,7 +353,8 @@ def load_scenario(path: str | Path, include_path: Iterable[str | Path] = (),
         robots.append(RobotSpec(name=r["name"], platform=r["platform"], tree=tree, start=r.get("start"),
                                 endurance_s=r.get("endurance_s"), tick_hz=float(r.get("tick_hz", 5.0)),
                                 overrides=extra, lidar=plain(r.get("lidar", {})), breadcrumbs=r.get("breadcrumbs", 0),
-                                sensors=check_sensors(r, i, r["platform"], path), line=line,
+                                sensors=check_sensors(r, i, r["platform"], path),
+                                deploy_at_s=float(r.get("deploy_at_s", 0.0)), line=line,
                                 start_line=r.key_line("start")))
 
     base = doc.get("base_station", {})

@@ -21,7 +21,10 @@ if TYPE_CHECKING:
 
 #: Where robots without a ``start`` stand, around the world's start (m), in order.
 START_OFFSETS_M = [(0, 0), (1.2, 0), (-1.2, 0), (0, 1.2), (0, -1.2), (2.4, 0), (-2.4, 0), (2.4, 1.2),
-                   (-2.4, 1.2), (2.4, -1.2), (-2.4, -1.2), (3.6, 0), (-3.6, 0)]
+                   (-2.4, 1.2), (2.4, -1.2), (-2.4, -1.2), (3.6, 0), (-3.6, 0),
+                   # then rows along a narrow passage (a portal in y, or in x)
+                   (1.2, 1.2), (-1.2, 1.2), (1.2, -1.2), (-1.2, -1.2), (0, 2.4), (0, -2.4), (1.2, 2.4),
+                   (-1.2, 2.4), (1.2, -2.4), (-1.2, -2.4), (0, 3.6), (0, -3.6)]
 #: A default start needs free space this far above it.
 DEFAULT_START_CLEAR_M = 0.3
 

@@ -138,3 +138,20 @@ def test_a_scenario_tree_resolves_only_in_its_folder_the_shipped_trees_or_includ
     path.write_text(path.read_text().replace("../mytrees/explorer.yaml", "link.yaml"))
     with pytest.raises(DelveError, match="is outside the allowed folders"):
         load_scenario(path)
+
+
+def test_a_robot_deployed_later_ticks_from_then(tmp_path):
+    from delve import TREES_DIR
+    from delve.executive.runner import Mission
+
+    path = tmp_path / "deploy.yaml"
+    path.write_text(f"""name: deploy
+world: {{generator: tunnel_network, total_length_m: 60, loops: 0}}
+robots:
+  - {{name: first, platform: legged, tree: {TREES_DIR / 'frontier_explorer.yaml'}}}
+  - {{name: later, platform: legged, tree: {TREES_DIR / 'frontier_explorer.yaml'}, deploy_at_s: 30}}
+""")
+    mission = Mission(load_scenario(path), duration_s=20.0)
+    assert mission.agents["later"].next_tick_s == 30.0 and mission.agents["first"].next_tick_s == 0.0
+    mission.run()
+    assert mission.robots["later"].distance_m == 0.0 < mission.robots["first"].distance_m
