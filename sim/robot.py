@@ -79,6 +79,8 @@ class SimRobot(RobotBody):
         self._status = IDLE
         self.blocked_reason = ""
         self._scans = 0
+        #: Sim time the robot spent moving (the paper's "operational" time, Table 3).
+        self.moving_s = 0.0
         self._detections: list[CameraDetection] = []
         self._signals: list[SignalReading] = []
         self._commands = 0
@@ -271,7 +273,13 @@ class SimRobot(RobotBody):
             return
         if self._drift_mps.any():
             self._drift = self._drift + self._drift_mps * dt_s
-        budget = self._platform.speed_mps * dt_s
+        before = self._distance
+        self._advance(self._platform.speed_mps * dt_s)
+        if self._distance > before:
+            self.moving_s += dt_s
+
+    def _advance(self, budget: float) -> None:
+        """Walk (or fly) up to ``budget`` metres along the path being followed."""
         while budget > 1e-9 and self._status == FOLLOWING:
             target = self._path[self._wp] - self._drift
             delta = target - self._pos

@@ -185,7 +185,8 @@ class VoxelBackend(WorldBackend):
         return {"free_volume_m3": round(len(self.truth) * self.world.voxel_size_m ** 3, 1)}
 
     def robot_figures(self, name: str, lost: Mapping[str, str]) -> dict[str, Any]:
-        start = {"start": [round(float(c), 3) for c in self.starts[name]]}
+        start = {"start": [round(float(c), 3) for c in self.starts[name]],
+                 "moving_s": round(self.robots[name].moving_s, 1)}
         return {**start, "lost": name in lost} if lost else start
 
     def map_undelivered(self, name: str) -> int:
