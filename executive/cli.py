@@ -158,6 +158,10 @@ def run(path: Path, out: Path | None, seed: int | None, duration_s: float | None
     print(f"{scenario.name}: {'succeeded' if rep['succeeded'] else 'FAILED'} after {rep['sim_time_s']:.0f} s sim "
           f"({rep['wall_time_s']:.1f} s wall), coverage {rep['coverage_fraction']:.1%}, "
           f"at base {rep['base_coverage_fraction']:.1%}")
+    if "artifacts" in rep:
+        a = rep["artifacts"]
+        print(f"  artifacts: {a['scored']} of {a['total']} scored, {a['submitted']} of {a['report_limit']} reports "
+              f"used, {a['detected']} detected, {a['reported_to_base']} reports delivered, {a['undelivered']} not")
     for reason in rep["outcome"]["reasons"]:
         print(f"  why: {reason}")
     for note in rep["outcome"]["notes"]:
