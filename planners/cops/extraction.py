@@ -37,11 +37,11 @@
   (0, 0, 0); ``keep`` cells are never merged, ``prior`` merges (a ``merged`` map)
   always hold. Only explored cells are merged, so the cells of an open area that
   nobody has explored yet stay locations of their own, the frontiers' targets, and
-  join the region once explored. A region's position is its member's position nearest the mean of
-  its members' positions; it is explored when every member is; its edges are its
-  members' edges to other locations, with lengths between positions. The
-  topology's ``merged`` maps every member to its region. ``open_radius_m=None``
-  merges nothing (the lattice's cells alone).
+  join the region once explored. A region's position is its member's position
+  nearest the mean of its members' positions; it is explored when every member is;
+  its edges are its members' edges to other locations, with lengths between
+  positions. The topology's ``merged`` maps every member to its region.
+  ``open_radius_m=None`` merges nothing (the lattice's cells alone).
 * The dense steps run on the box of the known-free voxels only (plus a margin for
   the frontier test), so their cost follows the mapped part of the world.
 * A communication edge (~>) joins two locations whose *sight points* (positions
