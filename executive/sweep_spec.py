@@ -49,8 +49,9 @@ _ID_UNSAFE = re.compile(r"[^A-Za-z0-9._=+-]+")
 
 @dataclass(frozen=True)
 class Override:
-    """One scenario key set by a sweep: its dotted ``path``, plain ``value`` and the
-    sweep file's line that gives it."""
+    """One scenario key set by a sweep: its dotted ``path``, its ``value`` as read (a
+    mapping or list keeps its lines, as the scenario's checks want them) and the sweep
+    file's line that gives it."""
 
     path: str
     value: Any
@@ -264,7 +265,7 @@ def _check_path(key: Any, path: Path, line: int | None, where: str) -> str:
 def _overrides(mapping: Any, path: Path, where: str, line: int | None) -> tuple[Override, ...]:
     if not isinstance(mapping, dict):
         raise DelveError(f"{where}: a mapping of dotted scenario keys to values", path, line)
-    return tuple(Override(_check_path(k, path, mapping.key_line(k), where), plain(v), mapping.key_line(k))
+    return tuple(Override(_check_path(k, path, mapping.key_line(k), where), v, mapping.key_line(k))
                  for k, v in mapping.items())
 
 
@@ -280,7 +281,7 @@ def _grid(doc: YamlDict, path: Path) -> list[list[Override]]:
         if not isinstance(values, list) or not values:
             raise DelveError(f"grid: {short_repr(key)}: a non-empty list of values, not {short_repr(values)}", path,
                              line)
-        axes.append([Override(key, plain(v), values.item_line(i) if isinstance(values, YamlList) else line)
+        axes.append([Override(key, v, values.item_line(i) if isinstance(values, YamlList) else line)
                      for i, v in enumerate(values)])
     return axes
 

@@ -193,3 +193,18 @@ def test_one_plot_per_figure_that_varies(tmp_path):
     written = plot_figures(table, sweep, tmp_path / "plots")
     assert [p.name for p in written] == ["succeeded.png", "coverage_fraction.png"]
     assert all(p.stat().st_size > 1000 for p in written)
+
+
+def test_a_whole_list_can_be_overridden(tmp_path):
+    """A team of two in place of the scenario's one robot (paths resolve from the scenario)."""
+    sweep = load_sweep(sweep_file(tmp_path, """
+scenarios: [SMALL]
+runs:
+  - label: two
+    set:
+      robots:
+        - {name: a, platform: legged, tree: ../../../trees/frontier_explorer.yaml}
+        - {name: b, platform: legged, tree: ../../../trees/frontier_explorer.yaml}
+"""))
+    (run,) = sweep.runs
+    assert run.run_id == "small_tunnel-two-s4" and [r["name"] for r in run.overrides[0].value] == ["a", "b"]
