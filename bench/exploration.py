@@ -10,10 +10,14 @@ coverage.
 
 Worlds: a tunnel network, a two-level tunnel network joined by a ramp, and a cave
 (no shaft: the legged robot must be able to reach all of it), each with several
-seeds. Missions run in-process (``delve.executive.runner.Mission``), one world and
-seed per worker process.
+seeds. The runs are one sweep (``delve.executive.sweep``, docs/sweeps.md): worlds x
+trees x seeds on a Dask LocalCluster of ``--jobs`` workers (or the cluster at
+``--scheduler``), each run building its own world; the rows come from the sweep's
+table (T90 and T80 are the report's ``coverage_reached_s``). ``--out DIR`` keeps the
+sweep (its file, runs, table and plots) and a second start resumes it; by default it
+goes into a temporary folder.
 
-    .venv/bin/python bench/exploration.py [--quick] [--seeds 1 2 3] [--jobs 2]
+    .venv/bin/python bench/exploration.py [--quick] [--seeds 1 2 3] [--jobs 2] [--out DIR]
 
 Prints the command, one row per run, then the median T90 per planner and world and
 the ratio GBPlanner2 / baseline (goal: at most 0.8), and the same for T80 (80 %
@@ -27,7 +31,6 @@ for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUME
     os.environ.setdefault(_var, "1")
 
 import argparse
-import multiprocessing
 import shlex
 import statistics
 import sys
@@ -86,43 +89,44 @@ def scenario_doc(world: dict, tree: Path, seed: int) -> dict:
     }
 
 
-def t_reach(samples: list, fraction: float) -> float | None:
-    """Sim time at which team coverage first reaches ``fraction`` (interpolated)."""
-    prev = None
-    for s in samples:
-        if s.team >= fraction:
-            if prev is None or s.team == prev.team:
-                return float(s.t)
-            return float(prev.t + (fraction - prev.team) / (s.team - prev.team) * (s.t - prev.t))
-        prev = s
-    return None
+def sweep_doc(worlds: dict[str, dict], seeds: list[int]) -> dict:
+    """The sweep: one runs entry per world (labelled by its name), the trees as a grid."""
+    return {"name": "exploration", "scenarios": ["scenario.yaml"], "seeds": seeds,
+            "runs": [{"label": name, "set": {"world": spec}} for name, spec in worlds.items()],
+            "grid": {"robots.0.tree": [str(tree) for tree in TREES.values()]}}
 
 
-def run_world(job: tuple[str, dict, int]) -> list[Run]:
-    """Both planners on one world and seed (the world is generated once)."""
-    import numpy as np
-    from delve.executive.runner import Mission
-    from delve.executive.scenario import load_scenario
+def run_sweep(worlds: dict[str, dict], seeds: list[int], out: Path, jobs: int, scheduler: str | None) -> list[Run]:
+    """Run the sweep into ``out``; its rows as Runs (a failed run stops the bench)."""
+    from delve.executive.sweep import run_sweep as sweep_runs
+    from delve.executive.sweep_spec import load_sweep
 
-    name, world_spec, seed = job
-    out: list[Run] = []
-    world = None
-    with tempfile.TemporaryDirectory() as tmp:
-        for planner, tree in TREES.items():
-            path = Path(tmp) / f"{planner}.yaml"
-            path.write_text(yaml.safe_dump(scenario_doc(world_spec, tree, seed)))
-            scenario = load_scenario(path)
-            if world is None:
-                world = scenario.build_world(seed=seed)
-            t = time.perf_counter()
-            mission = Mission(scenario, seed=seed, world=world)
-            mission.run()
-            wall = time.perf_counter() - t
-            robot = mission.robots["anymal"]
-            out.append(Run(name, seed, planner, t_reach(mission.state.samples, TARGET),
-                           t_reach(mission.state.samples, TARGET_LOW), mission.state.samples[-1].team, mission.clock.now_s, robot.distance_m,
-                           bool(np.linalg.norm(robot.position - robot.home) <= 1.5), mission.succeeded, wall))
-    return out
+    out.mkdir(parents=True, exist_ok=True)
+    first = next(iter(worlds.values()))
+    (out / "scenario.yaml").write_text(yaml.safe_dump(scenario_doc(first, TREES["frontier"], seeds[0])))
+    (out / "sweep.yaml").write_text(yaml.safe_dump(sweep_doc(worlds, seeds), sort_keys=False))
+    t0 = time.perf_counter()
+
+    def done(n: int, total: int, spec, record: dict) -> None:
+        print(f"  [{n}/{total}] {spec.run_id} {record['status']} ({time.perf_counter() - t0:.0f} s)",
+              file=sys.stderr, flush=True)
+
+    result = sweep_runs(load_sweep(out / "sweep.yaml"), out / "results", workers=None if scheduler else jobs,
+                        scheduler=scheduler, progress=done)
+    failed = result.table[result.table["status"] != "ok"]
+    if len(failed):
+        raise SystemExit("runs failed: " + "; ".join(f"{r.run_id}: {r.error}" for r in failed.itertuples()))
+    planner_of = {tree.name: name for name, tree in TREES.items()}
+    return [Run(row["label"], int(row["seed"]), planner_of[Path(row["robots.0.tree"]).name],
+                _time(row["coverage_reached_s.90%"]), _time(row["coverage_reached_s.80%"]),
+                float(row["coverage_fraction"]), float(row["sim_time_s"]), float(row["robots.anymal.distance_m"]),
+                bool(row["robots.anymal.returned_home"]), bool(row["succeeded"]), float(row["wall_time_s"]))
+            for _, row in result.table.iterrows()]
+
+
+def _time(value) -> float | None:
+    """A table cell of a sim time: None when the coverage was never reached."""
+    return None if value is None or value != value else float(value)
 
 
 def fmt_t(t: float | None) -> str:
@@ -142,7 +146,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--quick", action="store_true", help="smaller worlds and one seed (a minute or two)")
     ap.add_argument("--seeds", type=int, nargs="+", default=None, help="world/mission seeds (default 1 to 5)")
     ap.add_argument("--worlds", nargs="+", choices=sorted(WORLDS), default=list(WORLDS))
-    ap.add_argument("--jobs", type=int, default=min(2, os.cpu_count() or 1), help="worker processes")
+    ap.add_argument("--jobs", type=int, default=min(2, os.cpu_count() or 1), help="workers of the local cluster")
+    ap.add_argument("--scheduler", metavar="ADDRESS", help="run the sweep on the Dask cluster at ADDRESS")
+    ap.add_argument("--out", type=Path, help="keep the sweep in DIR (and resume it there); default: a temporary folder")
     args = ap.parse_args(argv)
     seeds = args.seeds or ([1] if args.quick else [1, 2, 3, 4, 5])
     print("$ " + " ".join(shlex.quote(a) for a in [Path(sys.executable).name, *sys.argv]))
@@ -157,26 +163,17 @@ def main(argv: list[str] | None = None) -> int:
         params = ", ".join(f"{k}={v}" for k, v in spec.items() if k != "generator")
         print(f"world {name}: {spec['generator']}({params})")
     print(f"robot: legged (ANYmal-like), endurance {ENDURANCE_S:.0f} s, mission limit {DURATION_S:.0f} s; "
-          f"seeds {seeds}; {args.jobs} worker(s); load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
+          f"seeds {seeds}; {args.scheduler or f'{args.jobs} worker(s)'}; "
+          f"load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
     print(f"trees: GBPlanner2 = {TREES['GBPlanner2'].relative_to(ROOT)}, "
           f"frontier = {TREES['frontier'].relative_to(ROOT)}")
     print()
-    jobs = [(name, spec, seed) for name, spec in worlds.items() for seed in seeds]
     t0 = time.perf_counter()
-    runs: list[Run] = []
-
-    def done(rs: list[Run]) -> None:
-        runs.extend(rs)
-        print(f"  [{len(runs) // len(TREES)}/{len(jobs)}] {rs[0].world} seed {rs[0].seed} done "
-              f"({time.perf_counter() - t0:.0f} s)", file=sys.stderr, flush=True)
-
-    if args.jobs > 1:
-        with multiprocessing.get_context("spawn").Pool(args.jobs) as pool:
-            for rs in pool.imap_unordered(run_world, jobs, chunksize=1):
-                done(rs)
+    if args.out:
+        runs = run_sweep(worlds, seeds, args.out, args.jobs, args.scheduler)
     else:
-        for job in jobs:
-            done(run_world(job))
+        with tempfile.TemporaryDirectory() as tmp:
+            runs = run_sweep(worlds, seeds, Path(tmp), args.jobs, args.scheduler)
     header = (f"{'world':<16}{'seed':>5}  {'planner':<11}{'T90 (s)':>12}{'T80 (s)':>12}{'final cov':>11}"
               f"{'end (s)':>9}{'dist (m)':>10}{'home':>6}{'wall (s)':>10}")
     print(header)
