@@ -33,10 +33,23 @@ def test_watchdog_recovers_a_robot_whose_feet_are_stuck():
     ends_well(mission)
 
 
-def test_wifi_safety_backs_off_until_the_base_answers_then_resumes():
-    mission, _ = run_scenario(SCENARIOS_DIR / "cerberus_wifi.yaml")
+#: cerberus_wifi before the robot remembered where the link was lost: 25 back-offs
+#: (GBPlanner2 chose the same target beyond the radio edge again and again) and 66.3 %
+#: coverage when the supervisor called it home at 400 s.
+BACKOFFS_BEFORE, COVERAGE_BEFORE = 25, 0.663
+
+
+def test_wifi_safety_backs_off_until_the_base_answers_then_resumes(tmp_path):
+    mission, report = run_scenario(SCENARIOS_DIR / "cerberus_wifi.yaml", tmp_path)
     backoff = [e for e in events(mission, "backtrack") if e["node"] == "Backtrack until connected"]
     assert backoff, "WiFi safety never fired"
+    # It remembers where the link was lost and explores elsewhere: no oscillation at
+    # the radio edge (9 back-offs, none after 190 s), and no less explored for it.
+    backoffs = [e for e in backoff if e["trigger"]]
+    assert len(backoffs) <= 10 < BACKOFFS_BEFORE
+    assert len(events(mission, "link_loss")) == len(backoffs)
+    assert backoffs[-1]["t"] < 0.6 * mission.finished_s
+    assert report["coverage_fraction"] >= COVERAGE_BEFORE
     reconnected = [e for e in events(mission, "backtrack_done") if e["node"] == "Backtrack until connected"]
     assert reconnected and reconnected[0]["reason"] == "condition holds"
     resumed = [e for e in events(mission, "gbplanner_path") if e["t"] > reconnected[0]["t"]]
