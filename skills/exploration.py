@@ -7,9 +7,8 @@ import numpy as np
 from py_trees.common import Status
 from py_trees.ports import PortInformation
 
-from ..planners.frontier import (MAX_GOAL_OFFSET_M, VIEWPOINT_SPACING_M, FrontierCluster, FrontierGoal,
-                                 frontier_clusters, frontier_voxels, nearest_frontier, observable_frontiers,
-                                 viewpoint_nodes)
+from ..planners.frontier import (MAX_GOAL_OFFSET_M, FrontierCluster, FrontierGoal, frontier_clusters,
+                                 frontier_voxels, nearest_frontier)
 from ..planners.occupancy import Grid
 from ..planners.geometry import xyz
 from .base import Param, Skill
@@ -20,10 +19,9 @@ from .robot import PathStatus
 class ExploreFrontiers(Skill):
     """Nearest-frontier exploration: go to the nearest reachable frontier cluster, repeat.
 
-    Frontier voxels (known free next to unknown) of the onboard map that the robot's
-    LiDAR could observe from a node it can reach (within its view up, with a clear
-    line) are clustered; the cluster whose goal node is nearest along the navigation
-    graph is chosen and the robot follows the path to it. The voxels of a cluster that
+    Frontier voxels (known free next to unknown) of the onboard map are clustered; the
+    cluster whose goal node is nearest along the navigation graph is chosen and the
+    robot follows the path to it. The voxels of a cluster that
     is still a frontier after a visit, or whose path is blocked, are blacklisted: never
     goals again.
 
@@ -137,12 +135,12 @@ float, 2.0, "how often the target cluster is re-checked", exclusive_minimum=0),
         return Status.RUNNING
 
     def _clusters(self, grid: Grid, plan: Plan, candidates: np.ndarray) -> list[FrontierCluster]:
-        """Clusters of the ``candidates`` (frontier voxels) that the robot's sensor can
-        observe from a node it can reach (:func:`observable_frontiers`)."""
-        viewpoints = plan.graph.positions[viewpoint_nodes(plan.graph, plan.distances, VIEWPOINT_SPACING_M)]
-        seen = observable_frontiers(grid, candidates, viewpoints,
-                                    view_up_deg=self.robot.view_up_deg, reach_m=self.p["max_goal_offset_m"])
-        return frontier_clusters(grid, seen, cluster_radius_m=self.p["cluster_radius_m"],
+        """Clusters of the ``candidates`` (frontier voxels). Leaving out the voxels no
+        reachable node's LiDAR could observe (:func:`observable_frontiers`, which
+        map.png uses) made each planning step about 7 times slower and lost coverage
+        on the demo (docs/benchmarks.md, "Frontiers after a visit"), so the explorer
+        does not."""
+        return frontier_clusters(grid, candidates, cluster_radius_m=self.p["cluster_radius_m"],
                                  min_cluster_voxels=self.p["min_cluster_voxels"],
                                  max_extent_m=self.p["max_cluster_extent_m"])
 
