@@ -53,7 +53,7 @@ def test_a_legged_start_above_the_floor_lands_on_it_and_the_report_says_where(tm
     assert start[:2].tolist() == [2.0, 0.0] and 0.0 <= start[2] <= 0.2
     assert mission.robots["anymal"].position[2] == pytest.approx(start[2] + 0.5)
     figures = mission.backend.robot_figures("anymal", {})
-    assert figures == {"start": [2.0, 0.0, round(float(start[2]), 3)]}
+    assert figures == {"start": [2.0, 0.0, round(float(start[2]), 3)], "moving_s": 0.0}
     assert "start" in mission.backend.robot_figures("obelix", {})
 
 
