@@ -19,7 +19,11 @@ goes into a temporary folder.
 
     .venv/bin/python bench/exploration.py [--quick] [--seeds 1 2 3] [--jobs 2] [--out DIR]
 
-Prints the command, one row per run, then the median T90 per planner and world and
+Prints the command, one row per run, each planner's T90 and time to finish against the
+lower bound (``planners/exploration_bound.py``: the shortest walk over the generator's
+centreline within LiDAR range of every passage, at top speed; issue 17's goal is
+GBPlanner2's time to finish within 2x of it on tunnel networks), then the median T90
+per planner and world and
 the ratio GBPlanner2 / baseline (goal: at most 0.8), and the same for T80 (80 %
 coverage), since parts of some generated worlds are out of a legged robot's reach.
 """
@@ -124,6 +128,31 @@ def run_sweep(worlds: dict[str, dict], seeds: list[int], out: Path, jobs: int, s
             for _, row in result.table.iterrows()]
 
 
+def lower_bounds(worlds: dict[str, dict], seeds: list[int]) -> dict[tuple[str, int], tuple[float, float]]:
+    """Per world and seed, the physical limit (s) on exploring it and on exploring it
+    and coming home: the shortest walk over the generator's centreline that brings the
+    legged robot's LiDAR within range of every passage it can walk (no shafts), at its
+    top speed (planners/exploration_bound.py)."""
+    import numpy as np
+    from delve.planners.exploration_bound import exploration_bound
+    from delve.sim import worldgen
+    from delve.sim.platforms import PLATFORMS
+
+    legged = PLATFORMS["legged"]
+    out = {}
+    for name, spec in worlds.items():
+        params = {k: v for k, v in spec.items() if k != "generator"}
+        for seed in seeds:
+            world = getattr(worldgen, spec["generator"])(seed, **params)
+            graph = world.centreline
+            start = min(graph.nodes, key=lambda n: float(np.linalg.norm(graph.nodes[n]["pos"] - world.start)))
+            walkable = lambda d: d.get("kind") != "shaft"  # noqa: E731
+            walk, tour = (exploration_bound(graph, start, legged.lidar.range_m, closed=closed, walkable=walkable)
+                          for closed in (False, True))
+            out[name, seed] = (walk.time_s(legged.speed_mps), tour.time_s(legged.speed_mps))
+    return out
+
+
 def _time(value) -> float | None:
     """A table cell of a sim time: None when the coverage was never reached."""
     return None if value is None or value != value else float(value)
@@ -198,6 +227,24 @@ def main(argv: list[str] | None = None) -> int:
         if ratios:
             print(f"{'all worlds':<16}{'':>23}{'':>21}{statistics.median(ratios):>8.2f}  (median of the ratios)")
         print()
+    bounds = lower_bounds(worlds, seeds)
+    header = (f"{'world':<16}{'bound (s)':>10}{'with home (s)':>15}{'T90 / bound':>24}{'end / bound with home':>30}")
+    print(header)
+    print(f"{'':<16}{'':>10}{'':>15}{'GBPlanner2  frontier':>24}{'GBPlanner2  frontier':>30}")
+    print("-" * len(header))
+    for name in worlds:
+        walk = statistics.median(bounds[name, s][0] for s in seeds)
+        tour = statistics.median(bounds[name, s][1] for s in seeds)
+        cells = []
+        for attr, key in (("t90_s", 0), ("sim_time_s", 1)):
+            for planner in TREES:
+                ratios = [getattr(r, attr) / bounds[name, r.seed][key] for r in runs
+                          if r.world == name and r.planner == planner and getattr(r, attr) is not None]
+                cells.append(f"{statistics.median(ratios):.2f}" if ratios else "—")
+        print(f"{name:<16}{walk:>10.0f}{tour:>15.0f}{cells[0]:>13}{cells[1]:>11}{cells[2]:>19}{cells[3]:>11}")
+    print("bound: the shortest walk over the centreline within LiDAR range of every passage, at top speed "
+          "(goal: GBPlanner2's end within 2x of it on tunnel networks)")
+    print()
     print(f"goal: T90 ratio GBPlanner2 / baseline <= 0.8; total wall time {time.perf_counter() - t0:.0f} s")
     return 0
 
