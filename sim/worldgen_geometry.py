@@ -80,7 +80,7 @@ class VoxelCanvas:
         return sl, c[0][:, None], c[1][None, :], c[2][None, None, :]
 
 
-def _horizontal_frame(a: np.ndarray, b: np.ndarray):
+def horizontal_frame(a: np.ndarray, b: np.ndarray):
     """Horizontal length, along-axis unit vector and left normal of segment a->b."""
     d = np.asarray(b[:2], float) - np.asarray(a[:2], float)
     length = float(np.hypot(d[0], d[1]))
@@ -104,7 +104,7 @@ def carve_tunnel(canvas: VoxelCanvas, a, b, width_m: float, height_m: float) -> 
     """
     a = np.asarray(a, float)
     b = np.asarray(b, float)
-    length, u, n = _horizontal_frame(a, b)
+    length, u, n = horizontal_frame(a, b)
     if length < 1e-9:
         return
     half = 0.5 * width_m
@@ -181,7 +181,7 @@ def carve_cave_segment(canvas: VoxelCanvas, a, b, width_a: float, width_b: float
     """
     a = np.asarray(a, float)
     b = np.asarray(b, float)
-    length, u, n = _horizontal_frame(a, b)
+    length, u, n = horizontal_frame(a, b)
     reach = 0.5 * max(width_a, width_b) * 1.3
     top = max(cave_section_top(height_a), cave_section_top(height_b))
     lo = np.minimum(a, b) - [reach, reach, 0.0]

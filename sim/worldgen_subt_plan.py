@@ -19,7 +19,7 @@ import numpy as np
 from .world import World
 from .worldgen_cave import CAVE_REACH
 from .worldgen_geometry import (GRID_MARGIN_M, VoxelCanvas, assemble_world, carve_cave_segment, carve_chamber,
-                                carve_tunnel, cave_section_top)
+                                carve_tunnel, cave_section_top, horizontal_frame)
 
 #: Junction chamber radius of mine drifts as a fraction of the widest drift there.
 CHAMBER_RADIUS_FACTOR = 0.6
@@ -205,12 +205,9 @@ def carve_corridor(canvas: VoxelCanvas, a, b, width_m: float, height_m: float,
     passage runs on ``extend_a_m`` / ``extend_b_m`` past its ends at the end's height.
     """
     a, b = np.asarray(a, float), np.asarray(b, float)
-    d = b[:2] - a[:2]
-    length = float(np.hypot(d[0], d[1]))
+    length, u, n = horizontal_frame(a, b)
     if length < 1e-9:
         return
-    u = d / length
-    n = np.array([-u[1], u[0]])
     half = 0.5 * width_m
     reach = half + max(extend_a_m, extend_b_m)
     lo = np.minimum(a, b) - [reach, reach, 0.0]

@@ -106,10 +106,11 @@ class ArtifactCourse(NoArtifacts):
                 continue
             pose = np.array([*robot.true_position, robot.yaw_rad])
             sensors = self.sensors[name]
-            before = set(sensors.detected)
+            known = len(sensors.detected)
             robot.receive_artifact_readings(sensors.sense(now_s, pose, robot.payload))
-            for artifact in sorted(set(sensors.detected) - before):
-                self.log("artifact_detected", robot=name, artifact=artifact)
+            if len(sensors.detected) > known:  # first detections, in the order they came
+                for artifact in list(sensors.detected)[known:]:
+                    self.log("artifact_detected", robot=name, artifact=artifact)
 
     def base_services(self) -> dict[str, Any]:
         return {REFEREE: self.desk}

@@ -134,15 +134,9 @@ def base_ctx(referee) -> AgentContext:
     return ctx
 
 
-def report(robot: str, position, cls: str = "drill", t_s: float = 1.0) -> dict:
-    return {"artifact_class": cls, "position": list(position), "probability": 0.97, "detections": 3, "t_s": t_s,
-            "source": "camera", "robot": robot}
-
-
-def test_the_base_station_merges_two_robots_reports_into_one_submission():
-    referee = FakeReferee()
-    ctx = base_ctx(referee)
-    tree = build("""
+def base_tree(ctx):
+    """The base station's artifact behaviours, submitting every new candidate at once."""
+    return build("""
 type: Parallel
 name: Base
 policy: success_on_all
@@ -151,6 +145,17 @@ children:
   - type: SubmitArtifacts
     policy: immediate
 """, ctx)
+
+
+def report(robot: str, position, cls: str = "drill", t_s: float = 1.0) -> dict:
+    return {"artifact_class": cls, "position": list(position), "probability": 0.97, "detections": 3, "t_s": t_s,
+            "source": "camera", "robot": robot}
+
+
+def test_the_base_station_merges_two_robots_reports_into_one_submission():
+    referee = FakeReferee()
+    ctx = base_ctx(referee)
+    tree = base_tree(ctx)
     radio = ctx.services["radio"]
     radio.deliver("r2", ARTIFACT_REPORT, report("r2", [10.0, 0.0, 1.0]))
     radio.deliver("r1", ARTIFACT_REPORT, report("r1", [11.0, 0.5, 1.0]))
@@ -167,15 +172,7 @@ children:
 def test_no_more_submissions_than_reports_left():
     referee = FakeReferee(reports_left=1)
     ctx = base_ctx(referee)
-    tree = build("""
-type: Parallel
-name: Base
-policy: success_on_all
-children:
-  - type: CollectArtifactReports
-  - type: SubmitArtifacts
-    policy: immediate
-""", ctx)
+    tree = base_tree(ctx)
     for i in range(3):
         ctx.services["radio"].deliver("r1", ARTIFACT_REPORT, report("r1", [30.0 * i, 0.0, 1.0]))
     for _ in range(3):
