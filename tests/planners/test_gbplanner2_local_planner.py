@@ -45,6 +45,45 @@ def test_same_inputs_and_seed_give_the_same_result():
     assert np.array_equal(r1.graph.vertices, r2.graph.vertices)
 
 
+#: One iteration's outcome for a fixed map and seed, recorded before the speed-ups of
+#: issue 17 (item 5): vertices, edges, hanging vertices, chosen vertex, path gain, gain
+#: casts, samples drawn, sum of vertex gains, sum of edge lengths, and the path. A
+#: faster planner must plan exactly the same.
+PINNED = {
+    "legged": (250, 1696, 0, 192, 11507.818630570599, 249, 1125, 187434.106232961, 1297.331750687208,
+               [[15.526, 11.5, 1.5], [17.553, 12.789, 1.5], [19.58, 14.077, 1.5], [21.608, 15.366, 1.5],
+                [23.635, 16.654, 1.5]]),
+    "aerial": (250, 1740, 0, 2, 1631.0304816849025, 59, 852, 124875.02544962379, 1880.041777868778,
+               [[15.526, 11.5, 2.5], [18.335, 12.932, 2.491], [21.143, 14.365, 2.481], [23.952, 15.797, 2.472]]),
+    "shaft": (300, 1848, 21, 166, 47.57107765822729, 299, 17224, 846.1461831525198, 855.7255034570046,
+              [[8.0, 4.0, 7.5], [9.388, 4.745, 7.5], [10.775, 5.49, 7.5]]),
+}
+
+
+def _pinned_case(name):
+    if name == "shaft":
+        g, west, hole = s.shaft_tunnel()
+        p = np.array([hole.lo[0] - 2.5, west[1], west[2] + 0.5])
+        return LocalPlanner(LEGGED.replace(num_vertices_max=300)).plan(g, p, np.random.default_rng(2))
+    cfg, up, vs = (LEGGED, 0.5, 0.2) if name == "legged" else (AERIAL, 1.5, 0.3)
+    g, a, b = s.straight_tunnel(length_m=40, mapped_to_m=26, yaw_deg=30, voxel_size_m=vs)
+    u = (b - a) / np.linalg.norm(b - a)
+    return LocalPlanner(cfg).plan(g, a + 10 * u + np.array([0, 0, up]), np.random.default_rng(5), yaw_rad=0.5)
+
+
+@pytest.mark.parametrize("name", sorted(PINNED))
+def test_a_fixed_map_and_seed_give_the_pinned_plan(name):
+    r = _pinned_case(name)
+    n_v, n_e, n_hang, best, gain, casts, samples, vgain_sum, length_sum, path = PINNED[name]
+    g = r.graph
+    assert (g.num_vertices, g.num_edges, int(g.hanging.sum()), r.best_vertex) == (n_v, n_e, n_hang, best)
+    assert (r.diagnostics.num_gain_evaluations, r.diagnostics.num_samples) == (casts, samples)
+    assert r.gain == pytest.approx(gain, rel=1e-9)
+    assert float(r.vertex_gains.sum()) == pytest.approx(vgain_sum, rel=1e-9)
+    assert float(g.lengths.sum()) == pytest.approx(length_sum, rel=1e-9)
+    assert np.allclose(r.path, path, atol=1e-3)
+
+
 def test_legged_paths_never_end_at_or_cross_hanging_vertices():
     g, west, hole = s.shaft_tunnel()
     p = np.array([hole.lo[0] - 2.5, west[1], west[2] + 0.5])
