@@ -1,0 +1,173 @@
+"""Observer planning (Williams et al., Section III-C): where to stand to observe a frontier.
+
+Traversable mesh vertices (equations 10-11), sub-sampled to one per neighbourhood and
+kept only if reachable from the agent; the reward of observing each frontier triangle
+from each candidate (equation 12) and the observer position of a frontier (equation 13).
+
+Departures from the paper: a vertex's normal is the area-weighted mean of the normals of
+its observed (non-frontier) triangles, each turned towards the viewpoint, instead of the
+eigenvector of the voxel it came from; turning it towards the viewpoint tells a floor
+(normal up) from a ceiling (normal down), which the paper's |e_z . xi| accepts alike.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import networkx as nx
+import numpy as np
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
+from scipy.spatial import cKDTree
+
+from .frontier_types import Frontier, FrontierMesh
+from .selection_params import CsiroSelectionParams
+
+
+@dataclass(frozen=True)
+class ObserverCandidates:
+    """The set A: candidate observer positions (N, 3) and the graph (nodes 0..N-1, edge
+    attribute ``weight`` in m) that joins neighbourhoods whose vertices the mesh joins."""
+
+    positions: np.ndarray
+    graph: nx.Graph
+
+    def __len__(self) -> int:
+        return len(self.positions)
+
+
+@dataclass(frozen=True)
+class Observer:
+    """A frontier's observer: position o_f, reward r_f (equation 13) and the index of the
+    candidate."""
+
+    position: np.ndarray
+    reward: float
+    index: int
+
+
+def surface_normals(mesh: FrontierMesh) -> np.ndarray:
+    """(V, 3) unit vertex normals from the mesh's observed (non-frontier) triangles, each
+    triangle's normal turned towards ``mesh.viewpoint`` and weighted by its area; zero
+    for a vertex of frontier triangles only."""
+    # Hand-written rather than trimesh's vertex_normals: the hull's triangles need not be
+    # consistently wound, so each is oriented towards the viewpoint first.
+    tri = mesh.triangles[~np.asarray(mesh.frontier, bool)]
+    corners = mesh.vertices[tri]
+    cross = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])  # |cross| = 2 area
+    towards = np.asarray(mesh.viewpoint, float) - corners.mean(axis=1)
+    cross[np.einsum("ij,ij->i", cross, towards) < 0] *= -1.0
+    normals = np.zeros_like(mesh.vertices, dtype=float)
+    for c in range(3):
+        np.add.at(normals, tri[:, c], cross)
+    length = np.linalg.norm(normals, axis=1)
+    ok = length > 0
+    normals[ok] /= length[ok, None]
+    return normals
+
+
+def traversable_vertices(mesh: FrontierMesh, params: CsiroSelectionParams,
+                         vertex_normals: np.ndarray | None = None) -> np.ndarray:
+    """(V,) bool: the set A'' of equations 10-11, vertices whose normal is within
+    ``eta_norm_deg`` of the z axis with no non-traversable vertex of a triangle within
+    ``eta_trav_m`` (a vertex of frontier triangles only is not traversable).
+    ``vertex_normals`` (default :func:`surface_normals`) must point towards the known side."""
+    normals = surface_normals(mesh) if vertex_normals is None else np.asarray(vertex_normals, float)
+    used = np.zeros(len(mesh.vertices), bool)
+    used[mesh.triangles.reshape(-1)] = True
+    flat = used & (normals[:, 2] >= math.cos(math.radians(params.eta_norm_deg)))  # equation 10
+    steep = mesh.vertices[used & ~flat]
+    if len(steep) == 0:
+        return flat
+    near = cKDTree(steep).query_ball_point(mesh.vertices[flat], r=params.eta_trav_m, return_length=True)
+    out = flat.copy()
+    out[np.flatnonzero(flat)[near > 0]] = False  # equation 11
+    return out
+
+
+def _mesh_edges(mesh: FrontierMesh, keep: np.ndarray) -> np.ndarray:
+    """(E, 2) unique edges of observed triangles between vertices in ``keep``."""
+    tri = mesh.triangles[~np.asarray(mesh.frontier, bool)]
+    edges = np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]])
+    edges = np.sort(edges, axis=1)
+    edges = edges[keep[edges[:, 0]] & keep[edges[:, 1]]]
+    return np.unique(edges, axis=0) if len(edges) else edges.reshape(0, 2)
+
+
+def subsample(mesh: FrontierMesh, keep: np.ndarray, spacing_m: float) -> ObserverCandidates:
+    """One vertex of ``keep`` per cell of ``spacing_m`` and connected piece of the mesh
+    (the one nearest the piece's mean), joined where any of their vertices are joined."""
+    idx = np.flatnonzero(keep)
+    if len(idx) == 0:
+        return ObserverCandidates(np.zeros((0, 3)), nx.Graph())
+    local = np.full(len(mesh.vertices), -1)
+    local[idx] = np.arange(len(idx))
+    edges = local[_mesh_edges(mesh, keep)]
+    adjacency = coo_matrix((np.ones(len(edges)), (edges[:, 0], edges[:, 1])), shape=(len(idx), len(idx)))
+    _, piece = connected_components(adjacency, directed=False)
+    points = mesh.vertices[idx]
+    cell = np.floor(points / spacing_m).astype(np.int64)
+    _, group = np.unique(np.column_stack([cell, piece]), axis=0, return_inverse=True)
+    group = group.reshape(-1)
+    n = int(group.max()) + 1
+    mean = np.zeros((n, 3))
+    np.add.at(mean, group, points)
+    mean /= np.bincount(group, minlength=n)[:, None]
+    order = np.lexsort((np.linalg.norm(points - mean[group], axis=1), group))
+    first = order[np.r_[True, np.diff(group[order]) != 0]]  # nearest to its group's mean
+    positions = points[first]
+    pairs = np.sort(group[edges], axis=1)
+    pairs = np.unique(pairs[pairs[:, 0] != pairs[:, 1]], axis=0) if len(pairs) else pairs
+    graph = nx.Graph()
+    graph.add_nodes_from(range(n))
+    graph.add_weighted_edges_from(
+        (int(a), int(b), float(np.linalg.norm(positions[a] - positions[b]))) for a, b in pairs)
+    return ObserverCandidates(positions, graph)
+
+
+def reachable(candidates: ObserverCandidates, agent_position: np.ndarray) -> ObserverCandidates:
+    """The candidates connected to the one nearest ``agent_position``, renumbered in
+    their order."""
+    if len(candidates) == 0:
+        return candidates
+    source = int(np.argmin(np.linalg.norm(candidates.positions - np.asarray(agent_position, float), axis=1)))
+    nodes = sorted(nx.node_connected_component(candidates.graph, source))
+    graph = nx.convert_node_labels_to_integers(candidates.graph.subgraph(nodes), ordering="sorted")
+    return ObserverCandidates(candidates.positions[nodes], graph)
+
+
+def observer_candidates(mesh: FrontierMesh, agent_position: np.ndarray, params: CsiroSelectionParams,
+                        vertex_normals: np.ndarray | None = None) -> ObserverCandidates:
+    """The set A: traversable vertices of ``mesh``, sub-sampled to ``observer_spacing_m``,
+    reachable from ``agent_position`` over the mesh."""
+    keep = traversable_vertices(mesh, params, vertex_normals)
+    return reachable(subsample(mesh, keep, params.observer_spacing_m), agent_position)
+
+
+def observation_rewards(candidates: np.ndarray, frontier: Frontier, d_max_m: float,
+                        params: CsiroSelectionParams) -> np.ndarray:
+    """(N, K) reward r(a, R) of observing each of the frontier's K triangles from each of N
+    candidate positions (equation 12; with ``reduced_dynamic_range``, d_max^3 / r^2 is
+    replaced by d_max^2 / r). The angle is between the triangle's normal (out of the
+    known space) and the view from the candidate through the triangle; triangles beyond
+    d_max or seen from behind give 0."""
+    view = frontier.points[None, :, :] - np.asarray(candidates, float)[:, None, :]
+    r = np.maximum(np.linalg.norm(view, axis=2), params.reward_min_range_m)
+    cos_plus = np.maximum(np.einsum("nkj,kj->nk", view, frontier.normals) / r, 0.0)
+    reach = d_max_m ** 2 / r if params.reduced_dynamic_range else d_max_m ** 3 / r ** 2
+    return frontier.areas[None, :] * cos_plus / 3.0 * np.maximum(reach - r, 0.0)
+
+
+def plan_observer(candidates: ObserverCandidates, frontier: Frontier, d_max_m: float,
+                  params: CsiroSelectionParams) -> Observer | None:
+    """The candidate that observes the most of ``frontier`` and its total reward
+    (equation 13; the first of equals), or None when there is no candidate."""
+    if len(candidates) == 0:
+        return None
+    total = observation_rewards(candidates.positions, frontier, d_max_m, params).sum(axis=1)
+    best = int(np.argmax(total))
+    return Observer(position=candidates.positions[best].copy(), reward=float(total[best]), index=best)
+
+
+__all__ = ["Observer", "ObserverCandidates", "observation_rewards", "observer_candidates", "plan_observer",
+           "reachable", "subsample", "surface_normals", "traversable_vertices"]
