@@ -1,0 +1,165 @@
+"""The visible mesh from one viewpoint by direct point-cloud visibility (Section III-A2, A3).
+
+The observed points plus the sphere points S(a, d_max) (equation 2) are transformed by the
+exponential inversion (equation 3); the convex hull of the transformed points and the viewpoint
+(qhull, equation 5) gives the visible points and, through the same indices, a watertight mesh of
+what the agent sees. Visible sphere points are frontier points (equation 6); edges longer than
+eta_disc are split at their middle, which becomes a discontinuity frontier point (equations 7-8),
+unless that middle lies within a voxel (d_vox) of an observed point (see :func:`split_long_edges`).
+scipy's ConvexHull is used rather than open3d's hidden_point_removal, which hard-codes the
+spherical-flipping kernel, not the paper's exponential one.
+"""
+from __future__ import annotations
+
+import numpy as np
+from scipy.spatial import ConvexHull, QhullError, cKDTree
+
+from .frontier_types import FrontierMesh
+from .params import CsiroFrontierParams
+
+#: A hull in three dimensions needs four points that span a volume.
+MIN_POINTS = 4
+
+
+def sphere_points(agent: np.ndarray, params: CsiroFrontierParams) -> np.ndarray:
+    """S(a, d_max): points on the sphere of radius d_max around ``agent``, about one voxel
+    (d_vox) apart, at the elevations the sensor sees (elevation_min_deg..elevation_max_deg).
+    Returns (M, 3), rows by elevation then azimuth."""
+    step = params.sphere_spacing_rad
+    lo, hi = np.radians(params.elevation_min_deg), np.radians(params.elevation_max_deg)
+    rows = max(int(np.ceil((hi - lo) / step)), 1)
+    out = []
+    for el in np.linspace(lo, hi, rows + 1):
+        n = max(int(np.ceil(2 * np.pi * np.cos(el) / step)), 1)
+        az = np.arange(n) * (2 * np.pi / n)
+        out.append(np.stack([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.full(n, np.sin(el))], axis=1))
+    return np.asarray(agent, float) + params.d_max_m * np.concatenate(out)
+
+
+def exponential_inversion(points: np.ndarray, agent: np.ndarray, gamma: float) -> np.ndarray:
+    """Equation 3: t(p - a) = (p - a) / ||p - a|| * ||p - a||^gamma. Points at the agent itself
+    must have been removed."""
+    d = np.asarray(points, float) - np.asarray(agent, float)
+    r = np.linalg.norm(d, axis=1)
+    return d * (r ** (gamma - 1.0))[:, None]
+
+
+def split_long_edges(vertices: np.ndarray, triangles: np.ndarray, frontier_vertex: np.ndarray,
+                     eta_disc_m: float, surface: cKDTree | None = None,
+                     surface_m: float = 0.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Disc (equations 7-8): every edge longer than ``eta_disc_m`` gets a new vertex at its middle,
+    a frontier point shared by the two triangles on the edge; a triangle with one, two or three
+    long edges becomes two, three or four triangles of the same orientation. Returns the new
+    (vertices, triangles, frontier_vertex).
+
+    With a ``surface`` (kd-tree of the observed points), a long edge whose middle lies within
+    ``surface_m`` of an observed point is no depth discontinuity and is left whole. This departs
+    from the paper: at grazing angles and in concave corners (a floor meeting a wall) the hull of
+    the transformed points skips observed points and spans them with long thin triangles whose
+    middles lie on seen surface, and splitting them would make frontiers along every corner."""
+    tri = np.asarray(triangles, dtype=np.int64)
+    if len(tri) == 0:
+        return vertices, tri, frontier_vertex
+    ends = np.stack([tri, np.roll(tri, -1, axis=1)], axis=2)        # (T, 3, 2): edge j = (v_j, v_j+1)
+    lo, hi = ends.min(axis=2).reshape(-1), ends.max(axis=2).reshape(-1)
+    long_edge = np.linalg.norm(vertices[lo] - vertices[hi], axis=1) > eta_disc_m
+    if surface is not None and long_edge.any():
+        at = np.flatnonzero(long_edge)
+        near, _ = surface.query(0.5 * (vertices[lo[at]] + vertices[hi[at]]), distance_upper_bound=surface_m)
+        long_edge[at[np.isfinite(near)]] = False
+    if not long_edge.any():
+        return vertices, tri, frontier_vertex
+    key = lo * len(vertices) + hi
+    ukeys, inv = np.unique(key[long_edge], return_inverse=True)
+    ua, ub = ukeys // len(vertices), ukeys % len(vertices)
+    mid = np.full(len(key), -1, dtype=np.int64)
+    mid[long_edge] = len(vertices) + inv
+    mid = mid.reshape(-1, 3)                                         # mid[t, j]: middle of edge j
+    new_vertices = np.concatenate([vertices, 0.5 * (vertices[ua] + vertices[ub])])
+    new_frontier = np.concatenate([frontier_vertex, np.ones(len(ukeys), dtype=bool)])
+
+    is_long = mid >= 0
+    count = is_long.sum(axis=1)
+    parts = [tri[count == 0]]
+    # rotate each split triangle so that its pattern of long edges is a canonical one:
+    # one long edge -> edge 0; two -> edges 0 and 1 (edge 2 short); three -> any.
+    for c, first in ((1, lambda m: np.argmax(m, axis=1)), (2, lambda m: (np.argmin(m, axis=1) + 1) % 3),
+                     (3, lambda m: np.zeros(len(m), dtype=np.int64))):
+        sel = np.flatnonzero(count == c)
+        if len(sel) == 0:
+            continue
+        r = first(is_long[sel])[:, None]
+        cols = (r + np.arange(3)) % 3
+        v = np.take_along_axis(tri[sel], cols, axis=1)
+        m = np.take_along_axis(mid[sel], cols, axis=1)
+        v0, v1, v2, m0, m1, m2 = v[:, 0], v[:, 1], v[:, 2], m[:, 0], m[:, 1], m[:, 2]
+        if c == 1:
+            new = [(v0, m0, v2), (m0, v1, v2)]
+        elif c == 2:
+            new = [(m0, v1, m1), (v0, m0, m1), (v0, m1, v2)]
+        else:
+            new = [(v0, m0, m2), (m0, v1, m1), (m2, m1, v2), (m0, m1, m2)]
+        parts.extend(np.stack(t, axis=1) for t in new)
+    return new_vertices, np.concatenate(parts), new_frontier
+
+
+def visible_mesh(cloud: np.ndarray, agent: np.ndarray,
+                 params: CsiroFrontierParams) -> tuple[FrontierMesh | None, str | None]:
+    """The mesh of what an agent at ``agent`` sees of the observed points ``cloud`` (N, 3), with its
+    frontier triangles (those with a frontier point: a visible sphere point or the middle of a long
+    edge). Triangles are oriented with their normals away from the agent, out of the known space.
+
+    Returns (mesh, None), or (None, reason) for a degenerate cloud: fewer than four points within
+    d_max, or all of them on one plane or line (then the agent sees no frontier)."""
+    a = np.asarray(agent, dtype=float)
+    cloud = np.asarray(cloud, dtype=float).reshape(-1, 3)
+    dist = np.linalg.norm(cloud - a, axis=1)
+    cloud = cloud[(dist > 0) & (dist <= params.d_max_m)]
+    if len(cloud) < MIN_POINTS:
+        return None, f"too few points in range: {len(cloud)} within {params.d_max_m} m (need {MIN_POINTS})"
+    if np.linalg.matrix_rank(cloud - cloud.mean(axis=0)) < 3:
+        return None, f"degenerate point cloud: the {len(cloud)} points in range lie on one plane"
+    sphere = sphere_points(a, params)
+    points = np.concatenate([cloud, sphere])
+    transformed = np.concatenate([exponential_inversion(points, a, params.gamma), np.zeros((1, 3))])
+    try:
+        hull = ConvexHull(transformed)
+    except QhullError as err:     # a cloud that defeats qhull is a degenerate view, not an error
+        return None, f"degenerate point cloud: qhull failed ({str(err).splitlines()[0]})"
+    tri = hull.simplices[~np.any(hull.simplices == len(points), axis=1)]   # drop faces at the viewpoint
+    used, tri = np.unique(tri, return_inverse=True)
+    tri = tri.reshape(-1, 3).astype(np.int64)
+    vertices = points[used]
+    frontier_vertex = used >= len(cloud)                                  # equation 6
+    vertices, tri, frontier_vertex = split_long_edges(vertices, tri, frontier_vertex, params.eta_disc_m,
+                                                      cKDTree(cloud), params.d_vox_m)
+    tri = _orient_away(vertices, tri, a)
+    return FrontierMesh(vertices=vertices, triangles=tri, frontier=frontier_vertex[tri].any(axis=1),
+                        viewpoint=a.copy()), None
+
+
+def _orient_away(vertices: np.ndarray, tri: np.ndarray, agent: np.ndarray) -> np.ndarray:
+    """``tri`` with the vertex order of each triangle flipped where its normal faces the agent."""
+    p = vertices[tri]
+    n = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+    flip = np.einsum("ij,ij->i", n, p.mean(axis=1) - agent) < 0
+    out = tri.copy()
+    out[flip, 1], out[flip, 2] = tri[flip, 2], tri[flip, 1]
+    return out
+
+
+def triangle_geometry(mesh: FrontierMesh) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(centroids (T, 3), unit normals (T, 3) away from the viewpoint, areas (T,)) of the mesh's
+    triangles; a triangle of no area gets the direction from the viewpoint as its normal."""
+    p = mesh.vertices[mesh.triangles]
+    centroids = p.mean(axis=1)
+    n = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+    twice_area = np.linalg.norm(n, axis=1)
+    away = centroids - mesh.viewpoint
+    n = np.where(twice_area[:, None] > 0, n, away)
+    n /= np.maximum(np.linalg.norm(n, axis=1), np.finfo(float).tiny)[:, None]
+    return centroids, n, 0.5 * twice_area
+
+
+__all__ = ["MIN_POINTS", "exponential_inversion", "sphere_points", "split_long_edges", "triangle_geometry",
+           "visible_mesh"]
