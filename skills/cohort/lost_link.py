@@ -1,0 +1,127 @@
+"""COHORT's timing and its lost-link rule on the robot (Kulkarni et al. 2022, section
+IV-B): explore T_C seconds between calls to the hub; when a call finds no link, explore
+T_C^e seconds more unless the box is explored, then go back to the last point that
+offered a link, and further back point by point if that one offers none either."""
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from py_trees.common import Status
+from py_trees.ports import PortInformation
+
+from ...planners.geometry import xyz
+from ..base import Param, Skill
+from ..motion import GoTo
+from .robot import cohort_params, linked
+
+#: What ``CohortTimer`` waits for: T_C or T_C^e (fields of CohortParams).
+SPANS = ("period_s", "extra_explore_s")
+
+
+class CohortTimer(Skill):
+    """Wait T_C (``span: period_s``: the exploration between two calls to the hub) or
+    T_C^e (``span: extra_explore_s``: the exploration a robot out of reach does before
+    it backtracks) of sim time, as ``cohort_params`` gives them. Runs beside the
+    exploration in a Parallel that ends when either does.
+
+    Returns RUNNING until the span has passed since it was entered, then SUCCESS.
+    """
+
+    PARAMS = {"span": Param(str, "period_s", "which COHORT time: T_C (period_s) or T_C^e (extra_explore_s)",
+                            choices=SPANS)}
+
+    def __init__(self, name: str, ctx: Any, remap: dict[str, str] | None = None, **params: Any):
+        super().__init__(name, ctx, remap, **params)
+        self.end_s = float("inf")
+
+    def initialise(self) -> None:
+        span = float(getattr(cohort_params(self.ctx), self.p["span"]))
+        self.end_s = self.ctx.clock.now_s + span
+        if self.p["span"] == "extra_explore_s":
+            self.event("cohort_extra_exploration", duration_s=span)
+
+    def update(self) -> Status:
+        left = self.end_s - self.ctx.clock.now_s
+        if left <= 1e-9:
+            return Status.SUCCESS
+        self.feedback_message = f"{left:.0f} s to go"
+        return Status.RUNNING
+
+
+class ExplorationOver(Skill):
+    """Whether this robot's exploration is over: GBPlanner2 decided that homing is due,
+    or it found nothing left to explore with no box around it (a box explored is not
+    the end: the hub gives the next one).
+
+    Reads ``homing_due``, ``exploration_complete`` and ``exploration_bbox``. Returns
+    SUCCESS when over, else FAILURE.
+    """
+
+    INPUT_PORTS = {
+        "homing_due": PortInformation(bool, required=False, description="GBPlanner2 calls for homing"),
+        "exploration_complete": PortInformation(bool, required=False, description="GBPlanner2 found nothing left"),
+        "exploration_bbox": PortInformation(dict | None, required=False, description="the box explored; null: none"),
+    }
+
+    def update(self) -> Status:
+        if self.read("homing_due") or (self.read("exploration_complete") and self.read("exploration_bbox") is None):
+            return Status.SUCCESS
+        return Status.FAILURE
+
+
+class ReturnToLinkPoint(GoTo):
+    """The lost-link rule's way back: go to the last point that offered a link to the
+    hub (``cohort_link_points``, written by ``CallHub``; the robot's home comes before
+    the first), ping the hub there, and when it does not answer (or the point cannot be
+    reached) go on to the point before, and so on.
+
+    Reads ``cohort_link_points``; writes ``goto_failure`` as ``GoTo``. Logs
+    ``cohort_backtrack`` when it sets out and ``cohort_link_point`` at each point
+    reached (linked or not). Returns RUNNING on the way; SUCCESS at a point where the
+    hub answers; FAILURE when no point offers a link.
+    """
+
+    PARAMS = {**{k: v for k, v in GoTo.PARAMS.items() if k not in ("goal", "goal_key")},
+              "ping_attempts": Param(int, 3, "pings tried at a point before it counts as without link", minimum=1)}
+    INPUT_PORTS = {"cohort_link_points": PortInformation(list, required=False, default_value=[],
+                                                         description="[x, y, z] points that offered a link to the "
+                                                         "hub, oldest first")}
+
+    def __init__(self, name: str, ctx: Any, remap: dict[str, str] | None = None, **params: Any):
+        super().__init__(name, ctx, remap, goal=None, **params)
+        self.points: list[np.ndarray] = []
+
+    def initialise(self) -> None:
+        super().initialise()
+        r = self.robot
+        self.points = [r.home.copy(), *(np.asarray(p, float) for p in self.read("cohort_link_points") or [])]
+        self.goal = self.points.pop()
+        self.event("cohort_backtrack", to=xyz(self.goal, 2), points_left=len(self.points),
+                   position=xyz(r.position, 2))
+
+    def _read_goal(self) -> np.ndarray | None:
+        return self.goal
+
+    def arrived(self) -> Status:
+        ok = linked(self.robot.radio, self.p["ping_attempts"])
+        self.event("cohort_link_point", at=xyz(self.goal, 2), linked=ok)
+        return Status.SUCCESS if ok else self._next("no link there")
+
+    def _fail(self, code: str, reason: str) -> Status:
+        if self.points:
+            return self._next(reason)
+        return super()._fail(code, reason)
+
+    def _next(self, why: str) -> Status:
+        """Go on to the link point before this one; FAILURE when none is left."""
+        if not self.points:
+            self.feedback_message = "no link point offers a link"
+            self.write("goto_failure", "not_reached")
+            return Status.FAILURE
+        self.goal, self.last_end, self.replans, self.moving = self.points.pop(), None, 0, False
+        self.feedback_message = f"{why}: on to {xyz(self.goal, 1)}"
+        return Status.RUNNING
+
+
+__all__ = ["SPANS", "CohortTimer", "ExplorationOver", "ReturnToLinkPoint"]
