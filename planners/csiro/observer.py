@@ -57,9 +57,9 @@ def surface_normals(mesh: FrontierMesh) -> np.ndarray:
     cross = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])  # |cross| = 2 area
     towards = np.asarray(mesh.viewpoint, float) - corners.mean(axis=1)
     cross[np.einsum("ij,ij->i", cross, towards) < 0] *= -1.0
-    normals = np.zeros_like(mesh.vertices, dtype=float)
-    for c in range(3):
-        np.add.at(normals, tri[:, c], cross)
+    corner_of = tri.reshape(-1)  # each triangle's sum goes to its three corners
+    normals = np.column_stack([np.bincount(corner_of, weights=np.repeat(cross[:, k], 3),
+                                           minlength=len(mesh.vertices)) for k in range(3)])
     length = np.linalg.norm(normals, axis=1)
     ok = length > 0
     normals[ok] /= length[ok, None]
@@ -85,63 +85,62 @@ def traversable_vertices(mesh: FrontierMesh, params: CsiroSelectionParams,
     return out
 
 
-def _mesh_edges(mesh: FrontierMesh, keep: np.ndarray) -> np.ndarray:
-    """(E, 2) unique edges of observed triangles between vertices in ``keep``."""
+def _observed_edges(mesh: FrontierMesh, keep: np.ndarray) -> np.ndarray:
+    """(E, 2) edges of observed (non-frontier) triangles between vertices in ``keep``
+    (an edge of two triangles twice)."""
     tri = mesh.triangles[~np.asarray(mesh.frontier, bool)]
     edges = np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]])
-    edges = np.sort(edges, axis=1)
-    edges = edges[keep[edges[:, 0]] & keep[edges[:, 1]]]
-    return np.unique(edges, axis=0) if len(edges) else edges.reshape(0, 2)
+    return edges[keep[edges[:, 0]] & keep[edges[:, 1]]]
 
 
-def subsample(mesh: FrontierMesh, keep: np.ndarray, spacing_m: float) -> ObserverCandidates:
-    """One vertex of ``keep`` per cell of ``spacing_m`` and connected piece of the mesh
-    (the one nearest the piece's mean), joined where any of their vertices are joined."""
+def _subsample(points: np.ndarray, piece: np.ndarray, spacing_m: float) -> np.ndarray:
+    """(P,) group of each point: one group per cell of ``spacing_m`` and connected piece,
+    numbered in the order of (cell, piece)."""
+    cell = np.floor(points / spacing_m).astype(np.int64)
+    cell -= cell.min(axis=0)
+    key = np.ravel_multi_index((*cell.T, piece), (*(cell.max(axis=0) + 1), int(piece.max()) + 1))
+    return np.unique(key, return_inverse=True)[1].reshape(-1)
+
+
+def _nearest_to_mean(points: np.ndarray, group: np.ndarray) -> np.ndarray:
+    """Index of the point of each group nearest to the group's mean (the first of equals)."""
+    mean = np.column_stack([np.bincount(group, weights=points[:, k]) for k in range(3)])
+    mean /= np.bincount(group)[:, None]
+    order = np.lexsort((np.linalg.norm(points - mean[group], axis=1), group))
+    return order[np.r_[True, np.diff(group[order]) != 0]]
+
+
+def observer_candidates(mesh: FrontierMesh, agent_position: np.ndarray, params: CsiroSelectionParams,
+                        vertex_normals: np.ndarray | None = None) -> ObserverCandidates:
+    """The set A: traversable vertices of ``mesh`` (:func:`traversable_vertices`), one per
+    neighbourhood of ``observer_spacing_m`` and connected piece of the mesh (the vertex
+    nearest the neighbourhood's mean), kept when the mesh joins them to the candidate
+    nearest ``agent_position``; two candidates are joined where any of their vertices are."""
+    keep = traversable_vertices(mesh, params, vertex_normals)
     idx = np.flatnonzero(keep)
     if len(idx) == 0:
         return ObserverCandidates(np.zeros((0, 3)), nx.Graph())
     local = np.full(len(mesh.vertices), -1)
     local[idx] = np.arange(len(idx))
-    edges = local[_mesh_edges(mesh, keep)]
-    adjacency = coo_matrix((np.ones(len(edges)), (edges[:, 0], edges[:, 1])), shape=(len(idx), len(idx)))
-    _, piece = connected_components(adjacency, directed=False)
+    edges = local[_observed_edges(mesh, keep)]
     points = mesh.vertices[idx]
-    cell = np.floor(points / spacing_m).astype(np.int64)
-    _, group = np.unique(np.column_stack([cell, piece]), axis=0, return_inverse=True)
-    group = group.reshape(-1)
-    n = int(group.max()) + 1
-    mean = np.zeros((n, 3))
-    np.add.at(mean, group, points)
-    mean /= np.bincount(group, minlength=n)[:, None]
-    order = np.lexsort((np.linalg.norm(points - mean[group], axis=1), group))
-    first = order[np.r_[True, np.diff(group[order]) != 0]]  # nearest to its group's mean
-    positions = points[first]
-    pairs = np.sort(group[edges], axis=1)
-    pairs = np.unique(pairs[pairs[:, 0] != pairs[:, 1]], axis=0) if len(pairs) else pairs
+    adjacency = coo_matrix((np.ones(len(edges)), (edges[:, 0], edges[:, 1])), shape=(len(idx), len(idx)))
+    piece = connected_components(adjacency, directed=False)[1]
+    group = _subsample(points, piece, params.observer_spacing_m)
+    first = _nearest_to_mean(points, group)
+    source = int(np.argmin(np.linalg.norm(points[first] - np.asarray(agent_position, float), axis=1)))
+    reached = piece[first] == piece[first[source]]  # a piece's groups are joined through its edges
+    number = np.cumsum(reached) - 1
+    positions = points[first[reached]]
+    pairs = np.sort(number[group[edges]], axis=1)
+    pairs = pairs[reached[group[edges[:, 0]]] & (pairs[:, 0] != pairs[:, 1])]
+    pairs = np.unique(pairs[:, 0] * len(positions) + pairs[:, 1])
     graph = nx.Graph()
-    graph.add_nodes_from(range(n))
-    graph.add_weighted_edges_from(
-        (int(a), int(b), float(np.linalg.norm(positions[a] - positions[b]))) for a, b in pairs)
+    graph.add_nodes_from(range(len(positions)))
+    a, b = np.divmod(pairs, len(positions))
+    graph.add_weighted_edges_from(zip(a.tolist(), b.tolist(),
+                                      np.linalg.norm(positions[a] - positions[b], axis=1).tolist()))
     return ObserverCandidates(positions, graph)
-
-
-def reachable(candidates: ObserverCandidates, agent_position: np.ndarray) -> ObserverCandidates:
-    """The candidates connected to the one nearest ``agent_position``, renumbered in
-    their order."""
-    if len(candidates) == 0:
-        return candidates
-    source = int(np.argmin(np.linalg.norm(candidates.positions - np.asarray(agent_position, float), axis=1)))
-    nodes = sorted(nx.node_connected_component(candidates.graph, source))
-    graph = nx.convert_node_labels_to_integers(candidates.graph.subgraph(nodes), ordering="sorted")
-    return ObserverCandidates(candidates.positions[nodes], graph)
-
-
-def observer_candidates(mesh: FrontierMesh, agent_position: np.ndarray, params: CsiroSelectionParams,
-                        vertex_normals: np.ndarray | None = None) -> ObserverCandidates:
-    """The set A: traversable vertices of ``mesh``, sub-sampled to ``observer_spacing_m``,
-    reachable from ``agent_position`` over the mesh."""
-    keep = traversable_vertices(mesh, params, vertex_normals)
-    return reachable(subsample(mesh, keep, params.observer_spacing_m), agent_position)
 
 
 def observation_rewards(candidates: np.ndarray, frontier: Frontier, d_max_m: float,
@@ -170,4 +169,4 @@ def plan_observer(candidates: ObserverCandidates, frontier: Frontier, d_max_m: f
 
 
 __all__ = ["Observer", "ObserverCandidates", "observation_rewards", "observer_candidates", "plan_observer",
-           "reachable", "subsample", "surface_normals", "traversable_vertices"]
+           "surface_normals", "traversable_vertices"]
