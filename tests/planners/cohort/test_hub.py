@@ -1,0 +1,62 @@
+"""delve.planners.cohort.hub: submaps in, global frontiers, answers, on the fork."""
+import numpy as np
+from delve.planners.cohort import CohortHub, CohortParams
+
+from .worlds import Z, base_map, cut, fork
+
+#: A tunnel's end face is about 80 points at 0.4 m: small f_min for the hand-made fork.
+PARAMS = CohortParams(f_min=20)
+
+
+def hub_after(*submaps):
+    """A hub fed ``(robot, index, x_lo, x_hi, trajectory)`` submaps of the fork."""
+    truth = fork()
+    m, fine = base_map(truth)
+    hub = CohortHub(PARAMS, fine)
+    for robot, index, lo, hi, traj in submaps:
+        flat, values = cut(truth, lo, hi)
+        m.merge(flat, values)
+        hub.add_submap(fine, robot, index, 0.0, flat, values, np.array(traj, float))
+    return hub, fine
+
+
+TRUNK = ("a", 0, 0, 20, [[3, 20, Z], [18, 20, Z]])
+JUNCTION = ("b", 0, 15, 40, [[18, 20, Z], [30, 20, Z]])
+
+
+def test_a_submap_updates_the_map_graph_and_frontiers():
+    hub, _ = hub_after(TRUNK)
+    info = hub.submaps[("a", 0)]
+    assert hub.stale and info.frontier_points > 50 and info.vertices == len(hub.graph) > 200
+    assert np.allclose(hub.home, [3, 20, Z]) and np.allclose(hub.robot_positions["a"], [18, 20, Z])
+    assert info.bbox_max[0] <= 20.0 + 1e-9
+    hub.update_frontiers()
+    assert not hub.stale and len(hub.clusters) == 1 and len(hub.links[0])
+    assert np.allclose(hub.frontier_centroids[:, :2], [[20.2, 20]], atol=0.3)
+
+
+def test_two_robots_at_the_fork_are_sent_to_different_branches():
+    hub, fine = hub_after(TRUNK, JUNCTION)
+    ra = hub.reposition(fine, "a", np.array([30, 20, Z]), 10.0, request_id=1)
+    rb = hub.reposition(fine, "b", np.array([30, 20, Z]), 10.0, request_id=7)
+    assert ra.ok and rb.ok and ra.frontier[0] > 39 and rb.frontier[0] > 39
+    assert (ra.frontier[1] - 20) * (rb.frontier[1] - 20) < 0
+    assert np.linalg.norm(ra.path[-1] - ra.frontier) <= PARAMS.edge_radius_m + 1e-9
+    assert [(a.robot, a.request_id) for a in hub.assignments] == [("a", 1), ("b", 7)]
+    assert hub.last_assignment["b"].result is rb
+
+
+def test_no_frontier_before_any_submap():
+    truth = fork()
+    _, fine = base_map(truth)
+    r = CohortHub(PARAMS, fine, home=np.array([3, 20, Z])).reposition(fine, "a", np.array([3, 20, Z]), 0.0)
+    assert r.reason == "no_frontier" and r.frontier is None
+
+
+def test_the_same_submaps_give_the_same_answers():
+    answers = []
+    for _ in range(2):
+        hub, fine = hub_after(TRUNK, JUNCTION)
+        r = hub.reposition(fine, "a", np.array([25, 20, Z]), 10.0)
+        answers.append((r.frontier.tolist(), r.path.tolist(), hub.graph.positions.tolist()))
+    assert answers[0] == answers[1]
