@@ -130,17 +130,20 @@ def observer_candidates(mesh: FrontierMesh, agent_position: np.ndarray, params: 
     first = _nearest_to_mean(points, group)
     source = int(np.argmin(np.linalg.norm(points[first] - np.asarray(agent_position, float), axis=1)))
     reached = piece[first] == piece[first[source]]  # a piece's groups are joined through its edges
-    number = np.cumsum(reached) - 1
-    positions = points[first[reached]]
-    pairs = np.sort(number[group[edges]], axis=1)
-    pairs = pairs[reached[group[edges[:, 0]]] & (pairs[:, 0] != pairs[:, 1])]
-    pairs = np.unique(pairs[:, 0] * len(positions) + pairs[:, 1])
+    edges = edges[reached[group[edges[:, 0]]]]
+    pairs = (np.cumsum(reached) - 1)[group[edges]]  # candidates renumbered among the reached
+    return ObserverCandidates(points[first[reached]], _candidate_graph(points[first[reached]], pairs))
+
+
+def _candidate_graph(positions: np.ndarray, pairs: np.ndarray) -> nx.Graph:
+    """Nodes 0..N-1 joined by each pair (k, 2) of different nodes, weighted by distance (m)."""
+    pairs = np.sort(pairs[pairs[:, 0] != pairs[:, 1]], axis=1)
+    a, b = np.divmod(np.unique(pairs[:, 0] * len(positions) + pairs[:, 1]), len(positions))
     graph = nx.Graph()
     graph.add_nodes_from(range(len(positions)))
-    a, b = np.divmod(pairs, len(positions))
     graph.add_weighted_edges_from(zip(a.tolist(), b.tolist(),
                                       np.linalg.norm(positions[a] - positions[b], axis=1).tolist()))
-    return ObserverCandidates(positions, graph)
+    return graph
 
 
 def observation_rewards(candidates: np.ndarray, frontier: Frontier, d_max_m: float,
@@ -151,8 +154,9 @@ def observation_rewards(candidates: np.ndarray, frontier: Frontier, d_max_m: flo
     known space) and the view from the candidate through the triangle; triangles beyond
     d_max or seen from behind give 0."""
     view = frontier.points[None, :, :] - np.asarray(candidates, float)[:, None, :]
-    r = np.maximum(np.linalg.norm(view, axis=2), params.reward_min_range_m)
-    cos_plus = np.maximum(np.einsum("nkj,kj->nk", view, frontier.normals) / r, 0.0)
+    distance = np.linalg.norm(view, axis=2)
+    cos_plus = np.maximum(np.einsum("nkj,kj->nk", view, frontier.normals) / np.maximum(distance, 1e-12), 0.0)
+    r = np.maximum(distance, params.reward_min_range_m)
     reach = d_max_m ** 2 / r if params.reduced_dynamic_range else d_max_m ** 3 / r ** 2
     return frontier.areas[None, :] * cos_plus / 3.0 * np.maximum(reach - r, 0.0)
 

@@ -1,6 +1,7 @@
 """delve.planners.csiro.observer: traversable vertices, candidates, equations 12-13."""
 from __future__ import annotations
 
+import networkx as nx
 import numpy as np
 import pytest
 from delve.planners.csiro.frontier_types import Frontier, FrontierMesh
@@ -98,7 +99,6 @@ def test_candidates_are_subsampled_and_connected():
     np.fill_diagonal(gaps, np.inf)
     assert gaps.min() > 0.25  # one vertex per neighbourhood, not every vertex
     assert len(cand.graph) == len(cand) and len(cand.graph.edges) > 0
-    import networkx as nx
     assert nx.is_connected(cand.graph)
 
 
