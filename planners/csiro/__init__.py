@@ -3,3 +3,15 @@
 Frontiers straight from LiDAR points by direct visibility (Section III-A), their
 sequential update (Section III-B, Algorithm 2), observer planning, sharing and selection.
 """
+from .observer import Observer, ObserverCandidates, observation_rewards, observer_candidates, plan_observer
+from .selection import (FailedFrontiers, GoalProgress, UavMomentum, UgvChoice, select_uav_frontier,
+                        select_ugv_frontier, uav_frontier_complete)
+from .selection_params import CsiroSelectionParams
+from .sharing import FrontierKey, FrontierSummary, TrajectoryPoints, discount_places, discounted_rewards, summarise
+
+__all__ = [
+    "CsiroSelectionParams", "FailedFrontiers", "FrontierKey", "FrontierSummary", "GoalProgress", "Observer",
+    "ObserverCandidates", "TrajectoryPoints", "UavMomentum", "UgvChoice", "discount_places", "discounted_rewards",
+    "observation_rewards", "observer_candidates", "plan_observer", "select_uav_frontier", "select_ugv_frontier",
+    "summarise", "uav_frontier_complete",
+]
