@@ -149,14 +149,16 @@ def _orient_away(vertices: np.ndarray, tri: np.ndarray, agent: np.ndarray) -> np
 
 
 def triangle_geometry(mesh: FrontierMesh) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(centroids (T, 3), unit normals (T, 3) away from the viewpoint, areas (T,)) of the mesh's
-    triangles; a triangle of no area gets the direction from the viewpoint as its normal."""
+    """(centroids (T, 3), unit normals (T, 3) away from the viewpoint (whatever the vertex order),
+    areas (T,)) of the mesh's triangles; a triangle of no area gets the direction from the viewpoint
+    as its normal."""
     p = mesh.vertices[mesh.triangles]
     centroids = p.mean(axis=1)
     n = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
     twice_area = np.linalg.norm(n, axis=1)
     away = centroids - mesh.viewpoint
     n = np.where(twice_area[:, None] > 0, n, away)
+    n *= np.where(np.einsum("ij,ij->i", n, away) < 0, -1.0, 1.0)[:, None]
     n /= np.maximum(np.linalg.norm(n, axis=1), np.finfo(float).tiny)[:, None]
     return centroids, n, 0.5 * twice_area
 
