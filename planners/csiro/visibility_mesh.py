@@ -5,7 +5,7 @@ exponential inversion (equation 3); the convex hull of the transformed points an
 (qhull, equation 5) gives the visible points and, through the same indices, a watertight mesh of
 what the agent sees. Visible sphere points are frontier points (equation 6); edges longer than
 eta_disc are split at their middle, which becomes a discontinuity frontier point (equations 7-8),
-unless that middle lies within a voxel (d_vox) of an observed point (see :func:`split_long_edges`).
+unless that middle lies within a voxel's diagonal of an observed point (see :func:`split_long_edges`).
 scipy's ConvexHull is used rather than open3d's hidden_point_removal, which hard-codes the
 spherical-flipping kernel, not the paper's exponential one.
 """
@@ -19,6 +19,9 @@ from .params import CsiroFrontierParams
 
 #: A hull in three dimensions needs four points that span a volume.
 MIN_POINTS = 4
+#: The middle of a long edge lies on seen surface when an observed point is within a voxel's
+#: diagonal (sqrt 3 d_vox, the farthest apart two points of one voxel can be) of it.
+SURFACE_VOXELS = np.sqrt(3.0)
 
 
 def sphere_points(agent: np.ndarray, params: CsiroFrontierParams) -> np.ndarray:
@@ -132,7 +135,7 @@ def visible_mesh(cloud: np.ndarray, agent: np.ndarray,
     vertices = points[used]
     frontier_vertex = used >= len(cloud)                                  # equation 6
     vertices, tri, frontier_vertex = split_long_edges(vertices, tri, frontier_vertex, params.eta_disc_m,
-                                                      cKDTree(cloud), params.d_vox_m)
+                                                      cKDTree(cloud), SURFACE_VOXELS * params.d_vox_m)
     tri = _orient_away(vertices, tri, a)
     return FrontierMesh(vertices=vertices, triangles=tri, frontier=frontier_vertex[tri].any(axis=1),
                         viewpoint=a.copy()), None
