@@ -25,6 +25,8 @@ PARAMS_SERVICE = "cohort_params"
 SUBMAP, REQUEST, ASSIGNMENT = "cohort_submap", "cohort_request", "cohort_assignment"
 #: Who the hub is on the radio.
 HUB = "base"
+#: ``ctx.services`` key of the agent's count of requests to the hub.
+REQUEST_COUNT = "cohort_requests"
 
 
 def cohort_params(ctx: AgentContext) -> CohortParams:
@@ -100,12 +102,15 @@ class CallHub(Skill):
     for the matching ``cohort_assignment``.
 
     At a successful ping the robot's position is appended to ``cohort_link_points``
-    (the points that offered a link, oldest first). With a frontier, the assignment
-    gives ``cohort_goal`` (where the hub's path ends, else the frontier),
+    (the points that offered a link, oldest first; it replaces the last one within
+    ``link_point_spacing_m``). With a frontier, the assignment gives ``cohort_target``
+    (the frontier), ``cohort_goal`` (where the hub's path ends, else the frontier),
     ``cohort_path`` (the path along the hub's global graph G_C) and
     ``exploration_bbox`` (the box D around the frontier); without one (the hub has
-    nothing to give) ``cohort_goal`` and ``cohort_path`` are null and the box is
-    lifted, so that GBPlanner2 explores on its own.
+    nothing to give) those are null and the box is lifted, so that GBPlanner2 explores
+    on its own. A frontier within ``repeat_radius_m`` of the last target, when the
+    robot found that box explored (``exploration_complete``), counts as none (reason
+    ``repeated``): the hub's frontier is one the robot's sensors cannot clear.
 
     Logs ``cohort_call`` (reached or not) and ``cohort_assignment_received``.
     Returns RUNNING while waiting for the answer; SUCCESS when it came; FAILURE when
@@ -116,13 +121,21 @@ class CallHub(Skill):
     PARAMS = {
         "ping_attempts": Param(int, 3, "pings tried before the hub counts as out of reach", minimum=1),
         "answer_timeout_s": Param(float, 10.0, "sim time to wait for the hub's answer", exclusive_minimum=0),
+        "link_point_spacing_m": Param(float, 2.0, "a link point this close to the last one replaces it", minimum=0),
+        "repeat_radius_m": Param(float, 4.0, "a target this close to the last one, whose box the robot found "
+                                 "explored, counts as no frontier", minimum=0),
     }
-    INPUT_PORTS = {"cohort_link_points": PortInformation(list, required=False, default_value=[],
-                                                         description="[x, y, z] points that offered a link to the "
-                                                         "hub, oldest first")}
+    INPUT_PORTS = {
+        "cohort_link_points": PortInformation(list, required=False, default_value=[], description="[x, y, z] "
+                                              "points that offered a link to the hub, oldest first"),
+        "cohort_target": PortInformation(list | None, required=False, description="the last frontier assigned"),
+        "exploration_complete": PortInformation(bool, required=False, description="GBPlanner2 found the box "
+                                                "explored"),
+    }
     OUTPUT_PORTS = {
         "cohort_link_points": PortInformation(list, description="[x, y, z] points that offered a link to the hub, "
                                               "oldest first"),
+        "cohort_target": PortInformation(list | None, description="[x, y, z] the frontier assigned; null: none"),
         "cohort_goal": PortInformation(list | None, description="[x, y, z] where the re-positioning path ends; null: "
                                        "no frontier"),
         "cohort_path": PortInformation(list | None, description="[[x, y, z], ...] the hub's path along G_C"),
@@ -149,9 +162,9 @@ class CallHub(Skill):
                 self.feedback_message = "hub out of reach"
                 self.event("cohort_call", reached=False, position=xyz(r.position, 2))
                 return Status.FAILURE
-            points = list(self.read("cohort_link_points") or [])
-            self.write("cohort_link_points", [*points, xyz(r.position, 2)])
-            self.request_id += 1
+            self._remember_link_point(r.position)
+            # One count per agent: a tree may call the hub from several places.
+            self.request_id = self.ctx.services[REQUEST_COUNT] = self.ctx.services.get(REQUEST_COUNT, 0) + 1
             r.radio.send(HUB, REQUEST, {"robot": self.ctx.name, "request_id": self.request_id,
                                         "position": xyz(r.position, 3), "t_s": now})
             self.asked_s = now
@@ -167,8 +180,26 @@ class CallHub(Skill):
         self.feedback_message = f"waiting for the hub (request {self.request_id})"
         return Status.RUNNING
 
+    def _remember_link_point(self, here: np.ndarray) -> None:
+        points = list(self.read("cohort_link_points") or [])
+        if points and np.linalg.norm(np.asarray(points[-1]) - here) <= self.p["link_point_spacing_m"]:
+            points.pop()
+        self.write("cohort_link_points", [*points, xyz(here, 2)])
+
+    def _repeated(self, frontier: Any) -> bool:
+        """Whether the hub sends the robot back to the frontier it was sent to last,
+        whose box it has since found explored (a frontier its sensors cannot clear)."""
+        last = self.read("cohort_target")
+        return (frontier is not None and last is not None and bool(self.read("exploration_complete"))
+                and float(np.linalg.norm(np.asarray(frontier, float) - np.asarray(last, float)))
+                <= self.p["repeat_radius_m"])
+
     def _apply(self, answer: dict[str, Any]) -> None:
         frontier, path = answer.get("frontier"), answer.get("path")
+        if self._repeated(frontier):
+            answer = {**answer, "reason": "repeated"}
+            frontier = None
+        self.write("cohort_target", None if frontier is None else xyz(frontier, 2))
         if frontier is None:
             goal = box = path = None
         else:
@@ -218,5 +249,5 @@ class FollowHubPath(GoTo):
         return super()._path(grid)
 
 
-__all__ = ["ASSIGNMENT", "HUB", "PARAMS_SERVICE", "REQUEST", "SUBMAP", "CallHub", "FollowHubPath", "SendSubmaps",
+__all__ = ["ASSIGNMENT", "HUB", "PARAMS_SERVICE", "REQUEST", "REQUEST_COUNT", "SUBMAP", "CallHub", "FollowHubPath", "SendSubmaps",
            "cohort_params", "linked"]

@@ -165,7 +165,7 @@ def test_no_answer_in_time_fails_and_the_next_call_asks_again(robot):
     answer(robot, request_id=1)  # too late: dropped by the next call
     node.tick_once()
     assert node.status == Status.RUNNING and sent(robot, REQUEST)[-1].data["request_id"] == 2
-    assert len(bb("cohort_link_points")) == 2
+    assert len(bb("cohort_link_points")) == 1  # the same place
 
 
 # --------------------------------------------------------------------- FollowHubPath
@@ -249,3 +249,37 @@ def test_return_ends_at_home_and_fails_when_no_point_links(tunnel):
     assert run(node, ctx, robot) == Status.FAILURE
     assert np.linalg.norm(robot.position - robot.home) <= 0.5
     assert [e["linked"] for e in events(ctx, "cohort_link_point")] == [False, False]
+
+
+def test_request_ids_count_per_agent_across_call_nodes(robot):
+    ctx = ctx_for(robot)
+    first, second = CallHub(name="Call", ctx=ctx), CallHub(name="Call again", ctx=ctx)
+    first.tick_once()
+    second.tick_once()
+    assert [m.data["request_id"] for m in sent(robot, REQUEST)] == [1, 2]
+
+
+def test_a_link_point_near_the_last_replaces_it(tunnel, robot):
+    _, a, _ = tunnel
+    ctx = ctx_for(robot)
+    node = CallHub(name="Call", ctx=ctx, link_point_spacing_m=2.0, answer_timeout_s=1.0)
+    for x in (3.0, 4.0, 10.0):
+        robot._pos = body(a, x)
+        node.tick_once()
+        ctx.clock.now_s += 2.0
+        node.tick_once()  # unanswered: FAILURE, the next tick calls again
+    assert [p[0] for p in bb("cohort_link_points")] == pytest.approx([body(a, 4.0)[0], body(a, 10.0)[0]])
+
+
+@pytest.mark.parametrize("explored, repeated", [(True, True), (False, False)])
+def test_the_same_target_again_after_its_box_was_explored_counts_as_none(robot, explored, repeated):
+    ctx = ctx_for(robot)
+    py_trees.blackboard.Blackboard.set("/r1/cohort_target", [31.0, 0.0, 1.5])
+    py_trees.blackboard.Blackboard.set("/r1/exploration_complete", explored)
+    node = CallHub(name="Call", ctx=ctx, repeat_radius_m=4.0)
+    node.tick_once()
+    answer(robot, request_id=1)  # the frontier at [30, 0, 1.5]
+    node.tick_once()
+    assert node.status == Status.SUCCESS
+    assert (bb("cohort_goal") is None) == repeated and (bb("exploration_bbox") is None) == repeated
+    assert events(ctx, "cohort_assignment_received")[0]["reason"] == ("repeated" if repeated else "assigned")
