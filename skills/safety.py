@@ -86,8 +86,10 @@ class BudgetElapsed(Skill):
 class Ping(Skill):
     """Ping the base station every ``period_s``; a ping can fail.
 
-    Writes ``ping_ok`` (the last ping's result) and ``failed_pings`` (consecutive
-    failures). Returns RUNNING (it is a background task).
+    Writes ``ping_ok`` (the last ping's result), ``failed_pings`` (consecutive
+    failures) and ``link_lost_at`` (where the robot was at the first of those
+    failures: the radio edge; None while pings succeed). Returns RUNNING (it is a
+    background task).
     """
 
     PARAMS = {
@@ -97,6 +99,8 @@ class Ping(Skill):
     OUTPUT_PORTS = {
         "ping_ok": PortInformation(bool, description="the last ping's result (True before the first)"),
         "failed_pings": PortInformation(int, description="consecutive failed pings"),
+        "link_lost_at": PortInformation(list | None, description="[x, y, z] where the first of the consecutive "
+                                        "failed pings was made (m); None while pings succeed"),
     }
 
     def __init__(self, name: str, ctx: Any, remap: dict[str, str] | None = None, **params: Any):
@@ -107,6 +111,7 @@ class Ping(Skill):
     def setup(self, **kwargs: Any) -> None:
         self.write("ping_ok", True)
         self.write("failed_pings", 0)
+        self.write("link_lost_at", None)
 
     def update(self) -> Status:
         now = self.ctx.clock.now_s
@@ -116,6 +121,8 @@ class Ping(Skill):
             self.failed = 0 if ok else self.failed + 1
             self.write("ping_ok", ok)
             self.write("failed_pings", self.failed)
+            if self.failed <= 1:
+                self.write("link_lost_at", None if ok else xyz(self.robot.position, 2))
         return Status.RUNNING
 
 
@@ -125,21 +132,26 @@ class RememberLinkLoss(Skill):
     """Remember where the robot found its link to the base station lost, so that its
     exploration discounts what lies beyond (the WiFi safety block, before it backs off).
 
-    Appends the robot's position to ``link_loss_points`` unless one of them lies
-    within ``merge_radius_m``; logs ``link_loss``. Always SUCCESS. The points are
+    Appends ``link_lost_at`` (where the first failed ping was made, which is
+    nearer the radio edge than where the robot noticed the loss) or else the robot's
+    position to ``link_loss_points`` unless one of them lies within
+    ``merge_radius_m``; logs ``link_loss``. Always SUCCESS. The points are
     cleared when the supervisor sends the robot exploring again or a breadcrumb
     extends the mesh.
     """
 
     PARAMS = {"merge_radius_m": Param(float, 2.0, "a loss this close to a remembered one is the same", minimum=0)}
     INPUT_PORTS = {"link_loss_points": PortInformation(list, required=False, default_value=[],
-                                                       description="[x, y, z] points where the link was lost")}
+                                                       description="[x, y, z] points where the link was lost"),
+                   "link_lost_at": PortInformation(list, required=False, description="[x, y, z] where the first "
+                                                   "failed ping of this loss was made (m)")}
     OUTPUT_PORTS = {"link_loss_points": PortInformation(list, description="[x, y, z] points where the link was "
                                                         "lost (m)")}
 
     def update(self) -> Status:
         points = list(self.read("link_loss_points") or [])
-        here = self.robot.position
+        lost_at = self.read("link_lost_at")
+        here = self.robot.position if lost_at is None else np.asarray(lost_at, float)
         known = bool(near_points(here, np.asarray(points, float), self.p["merge_radius_m"]).any())
         if not known:
             points.append(xyz(here, 2))

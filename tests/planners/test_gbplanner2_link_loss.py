@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 from delve.planners.gbplanner2 import synthetic as s
 from delve.planners.gbplanner2.config import GBPlannerConfig
-from delve.planners.gbplanner2.link_loss import LinkLoss, beyond_in_tree, near_points
+from delve.planners.gbplanner2.link_loss import LinkLoss, beyond_in_tree, near_points, segments_near
 from delve.planners.gbplanner2.planner import GBPlanner
 
 CFG = GBPlannerConfig.anymal_c(num_vertices_max=200, num_edges_max=3000)
@@ -27,9 +27,23 @@ def test_the_gain_beyond_a_link_loss_is_discounted_but_not_the_rest():
     gains = np.array([0.0, 10.0, 20.0, 30.0, 5.0, 6.0])
     loss = LinkLoss(np.array([[4.0, 0.0, 0.0]]), radius_m=1.0, gain_factor=0.1)
     assert loss.discount_tree(POSITIONS, PREDECESSOR, gains) == pytest.approx([0, 10, 2, 3, 5, 6])
-    # A point by the root (the robot stands there, and hears the base again) is left out.
+    # The robot stands by a point (it backed off until it heard the base again): only
+    # what lies toward the point is beyond it, not the rest around the robot.
     by_root = LinkLoss(np.array([[0.5, 0.0, 0.0]]), radius_m=1.0, gain_factor=0.0)
-    assert by_root.discount_tree(POSITIONS, PREDECESSOR, gains) == pytest.approx(gains)
+    assert by_root.discount_tree(POSITIONS, PREDECESSOR, gains) == pytest.approx([0, 0, 0, 0, 5, 6])
+
+
+def test_segments_near_a_point_and_coming_nearer_it():
+    starts, ends = np.zeros((3, 3)), np.array([[4.0, 0, 0], [0, 4.0, 0], [-1.0, 0, 0]])
+    point = np.array([[2.0, 0.5, 0.0]])
+    assert segments_near(starts, ends, point, 1.0).tolist() == [True, False, False]
+    assert segments_near(starts, ends, point, 3.0).tolist() == [True, True, True]
+    # only the steps that end nearer the point than 2.1 m (the root's distance) or pass
+    # within half of that
+    assert segments_near(starts, ends, point, 3.0, np.array([2.1])).tolist() == [True, False, False]
+    through = np.array([[3.0, 0.5, 0.0]])  # passes 0 m from the point, ends 1 m from it
+    assert segments_near(np.zeros((1, 3)), through, point, 3.0, np.array([0.9])).tolist() == [True]
+    assert not segments_near(starts, ends, np.zeros((0, 3)), 3.0).any()
 
 
 def test_frontiers_beyond_a_link_loss_on_a_graph_seen_from_home():

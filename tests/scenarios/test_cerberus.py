@@ -43,13 +43,15 @@ def test_wifi_safety_backs_off_until_the_base_answers_then_resumes(tmp_path):
     mission, report = run_scenario(SCENARIOS_DIR / "cerberus_wifi.yaml", tmp_path)
     backoff = [e for e in events(mission, "backtrack") if e["node"] == "Backtrack until connected"]
     assert backoff, "WiFi safety never fired"
-    # It remembers where the link was lost and explores elsewhere: no oscillation at
-    # the radio edge (9 back-offs, none after 190 s), and no less explored for it.
+    # It remembers where the first ping failed and explores elsewhere: no oscillation
+    # at the radio edge (3 back-offs, none at a place it already knew), at the price of
+    # a little of what it saw by poking past the edge again and again.
     backoffs = [e for e in backoff if e["trigger"]]
-    assert len(backoffs) <= 10 < BACKOFFS_BEFORE
-    assert len(events(mission, "link_loss")) == len(backoffs)
-    assert backoffs[-1]["t"] < 0.6 * mission.finished_s
-    assert report["coverage_fraction"] >= COVERAGE_BEFORE
+    assert len(backoffs) <= 5 < BACKOFFS_BEFORE
+    losses = events(mission, "link_loss")
+    assert len(losses) == len(backoffs)
+    assert sum(not e["new"] for e in losses) <= 1
+    assert report["coverage_fraction"] >= COVERAGE_BEFORE - 0.03
     reconnected = [e for e in events(mission, "backtrack_done") if e["node"] == "Backtrack until connected"]
     assert reconnected and reconnected[0]["reason"] == "condition holds"
     resumed = [e for e in events(mission, "gbplanner_path") if e["t"] > reconnected[0]["t"]]

@@ -244,6 +244,22 @@ def test_ping_counts_consecutive_failures(tunnel):
     assert {target for _, target in robot.radio.pings} == {"relay"}
 
 
+def test_ping_notes_where_the_first_of_the_failed_pings_was_made(tunnel):
+    grid, a, _ = tunnel
+    robot = FakeRobot(grid, body(a, 5.0))
+    ctx = make_ctx(robot)
+    ping = ping_node(ctx, "type: Ping\nperiod_s: 1.0")
+    robot.radio.ping_results.extend([True, False, False, True])
+    seen = []
+    for x in (5.0, 6.0, 7.0, 8.0):
+        robot._pos = body(a, x)
+        ping.tick_once()
+        seen.append(bb("link_lost_at"))
+        ctx.clock.now_s += 1.0
+    assert seen[0] is None and seen[3] is None
+    assert seen[1] == seen[2] == pytest.approx(list(body(a, 6.0)), abs=0.01)
+
+
 def test_ping_with_the_radio_down(tunnel):
     grid, a, _ = tunnel
     robot = FakeRobot(grid, body(a, 5.0))
@@ -358,3 +374,13 @@ def test_the_robot_remembers_where_it_lost_the_link_once_per_place(tunnel):
     node.tick_once()
     assert len(bb("link_loss_points")) == 2
     assert [e["new"] for e in events(ctx, "link_loss")] == [True, False, True]
+
+
+def test_the_robot_remembers_where_the_first_ping_failed_when_it_knows(tunnel):
+    grid, a, _ = tunnel
+    robot = FakeRobot(grid, body(a, 24.0))
+    ctx = make_ctx(robot)
+    node = build("type: RememberLinkLoss", ctx)
+    py_trees.blackboard.Blackboard.set(node.keys["link_lost_at"], list(body(a, 20.0)))
+    node.tick_once()
+    assert bb("link_loss_points")[0] == pytest.approx(list(body(a, 20.0)), abs=0.01)
