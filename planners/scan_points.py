@@ -12,8 +12,9 @@ The paper's algorithm, as implemented here:
    every such point ``i``, ``x_j`` binary. The instance is first reduced (identical
    points and candidates merged, points whose constraint another implies dropped,
    candidates that see a subset of another's dropped), which keeps the optimum.
-   Small instances are solved exactly with CBC (pulp, quiet, time limit, started
-   from the greedy cover); larger ones, or when CBC returns nothing better, with
+   Small instances are solved exactly with CBC (pulp, quiet, one thread, a limit
+   on branch-and-bound nodes so that the result does not depend on the machine's
+   speed, a wall-clock safety stop, started from the greedy cover); larger ones, or when CBC returns nothing better, with
    the greedy cover (most newly covered points first, then redundant scans removed).
 3. **Autonomous Full Scan** when the unseen part exceeds ``full_scan_fraction``
    (50 %) of the reachable workspace: the robot pauses, stops and scans every
@@ -39,8 +40,11 @@ import pulp
 FULL_SCAN_FRACTION = 0.5
 #: Reduced instances with at most this many (points x candidates) cells go to CBC.
 EXACT_MAX_SIZE = 200_000
-#: Wall-clock limit for CBC (seconds).
-TIME_LIMIT_S = 2.0
+#: CBC's work limit: branch-and-bound nodes (a result that the machine's load
+#: cannot change, unlike a time limit).
+NODE_LIMIT = 2000
+#: Wall-clock safety stop for CBC (seconds); only a pathological instance reaches it.
+TIME_LIMIT_S = 30.0
 #: Above this many rows (or columns) the quadratic dominance reductions are skipped.
 _DOMINANCE_MAX = 3000
 
@@ -107,7 +111,7 @@ def reachable_workspace(points: np.ndarray, body_pose: np.ndarray, candidates: n
 def select_scan_points(unseen_points: np.ndarray, body_pose: np.ndarray, candidates: np.ndarray,
                        visibility: Visibility, reachable_workspace_size: int, *,
                        full_scan_fraction: float = FULL_SCAN_FRACTION,
-                       exact_max_size: int = EXACT_MAX_SIZE,
+                       exact_max_size: int = EXACT_MAX_SIZE, node_limit: int = NODE_LIMIT,
                        time_limit_s: float = TIME_LIMIT_S) -> ScanPointSelection:
     """Choose the smallest set of scan points that covers the unseen part of the workspace.
 
@@ -119,12 +123,16 @@ def select_scan_points(unseen_points: np.ndarray, body_pose: np.ndarray, candida
         reachable_workspace_size: number of points in the reachable workspace, seen or not.
         full_scan_fraction: Autonomous Full Scan above this unseen fraction (the paper's 0.5).
         exact_max_size: largest reduced instance (points x candidates) solved with CBC.
-        time_limit_s: CBC's time limit; the greedy cover is kept if CBC finds nothing better.
+        node_limit: CBC's limit of branch-and-bound nodes; the greedy cover is kept if
+            CBC finds nothing better.
+        time_limit_s: CBC's wall-clock safety stop.
     """
     if not 0.0 <= full_scan_fraction <= 1.0:
         raise ValueError(f"full_scan_fraction must lie in [0, 1], got {full_scan_fraction}")
     if not (math.isfinite(time_limit_s) and time_limit_s > 0):
         raise ValueError(f"time_limit_s must be > 0, got {time_limit_s}")
+    if node_limit < 1:
+        raise ValueError(f"node_limit must be >= 1, got {node_limit}")
     cand = np.asarray(candidates, dtype=float).reshape(-1, 2)
     vis = visibility_of(unseen_points, body_pose, cand, visibility)
     n = len(vis)
@@ -141,7 +149,7 @@ def select_scan_points(unseen_points: np.ndarray, body_pose: np.ndarray, candida
         chosen, solver, optimal = np.zeros(0, dtype=int), "none", True
     else:
         chosen, solver, optimal = minimum_set_cover(vis[coverable], exact_max_size=exact_max_size,
-                                                    time_limit_s=time_limit_s)
+                                                    node_limit=node_limit, time_limit_s=time_limit_s)
     order = np.lexsort((cand[chosen, 1], cand[chosen, 0])) if len(chosen) else np.zeros(0, dtype=int)
     chosen = chosen[order]
     covered = vis[:, chosen].any(axis=1) if len(chosen) else np.zeros(n, dtype=bool)
@@ -160,7 +168,7 @@ def select_scan_points(unseen_points: np.ndarray, body_pose: np.ndarray, candida
 
 
 # ---- set cover -------------------------------------------------------------------
-def minimum_set_cover(covers: np.ndarray, *, exact_max_size: int = EXACT_MAX_SIZE,
+def minimum_set_cover(covers: np.ndarray, *, exact_max_size: int = EXACT_MAX_SIZE, node_limit: int = NODE_LIMIT,
                       time_limit_s: float = TIME_LIMIT_S) -> tuple[np.ndarray, str, bool]:
     """A smallest set of columns of ``covers`` ((N, K) bool) whose union covers every row.
 
@@ -178,7 +186,7 @@ def minimum_set_cover(covers: np.ndarray, *, exact_max_size: int = EXACT_MAX_SIZ
     if len(start) < len(greedy):
         greedy = cols[start]
     if reduced.size <= exact_max_size:
-        exact, proven = _cbc_cover(reduced, start, time_limit_s)
+        exact, proven = _cbc_cover(reduced, start, node_limit, time_limit_s)
         if exact is not None and (proven or len(exact) < len(greedy)):
             return np.sort(cols[exact]), "cbc", proven
     return np.sort(greedy), "greedy", len(greedy) <= 1
@@ -249,7 +257,8 @@ def _greedy_cover(a: np.ndarray) -> np.ndarray:
     return np.array(sorted(chosen), dtype=int)
 
 
-def _cbc_cover(a: np.ndarray, start: np.ndarray, time_limit_s: float) -> tuple[np.ndarray | None, bool]:
+def _cbc_cover(a: np.ndarray, start: np.ndarray, node_limit: int,
+               time_limit_s: float) -> tuple[np.ndarray | None, bool]:
     """Exact set cover with CBC, warm-started from ``start``. Returns (columns or None, proven)."""
     prob = pulp.LpProblem("scan_points", pulp.LpMinimize)
     x = [prob.add_variable(f"x{j}", cat=pulp.LpBinary) for j in range(a.shape[1])]
@@ -261,7 +270,8 @@ def _cbc_cover(a: np.ndarray, start: np.ndarray, time_limit_s: float) -> tuple[n
         v.setInitialValue(1 if j in in_start else 0)
     with warnings.catch_warnings():      # pulp 3.3+ prefers an external CBC; the bundled one is fine
         warnings.simplefilter("ignore", DeprecationWarning)
-        solver = pulp.PULP_CBC_CMD(msg=False, timeLimit=float(time_limit_s), warmStart=True, threads=1)
+        solver = pulp.PULP_CBC_CMD(msg=False, timeLimit=float(time_limit_s), maxNodes=int(node_limit),
+                                    warmStart=True, threads=1)
     try:
         prob.solve(solver)
     except pulp.PulpSolverError:

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..planners.geometry import xyz
-from ..planners.scan_points import ScanPointSelection, select_scan_points
+from ..planners.scan_points import NODE_LIMIT, ScanPointSelection, select_scan_points
 from ..planners.visibility import BodyCameras, first_hit_m, joint_directions, line_of_sight, surface_voxels
 from .base import AgentContext
 from .robot import MapView, Payload, Robot
@@ -162,7 +162,7 @@ class InspectionPlan:
 def plan_inspection(robot: Robot, record: SeenRecord, *, point: np.ndarray | None = None,
                     point_radius_m: float = 1.0, joint_grid_deg: float = 3.0, distance_zoom: bool = True,
                     zoom_step: float = 0.5, full_scan_fraction: float = 0.5,
-                    time_limit_s: float = 2.0) -> InspectionPlan:
+                    node_limit: int = NODE_LIMIT) -> InspectionPlan:
     """Scan points of the robot's payload over the unseen part of its reachable
     workspace (around ``point`` within ``point_radius_m`` when given), as the paper's
     autonomous scanning algorithm. Raises ValueError when the robot has no payload."""
@@ -181,7 +181,7 @@ def plan_inspection(robot: Robot, record: SeenRecord, *, point: np.ndarray | Non
     reachable = vis.any(axis=1)
     unseen = reachable & ~record.of(ijk)
     sel = select_scan_points(pts[unseen], pose, cand, vis[unseen], int(reachable.sum()),
-                             full_scan_fraction=full_scan_fraction, time_limit_s=time_limit_s)
+                             full_scan_fraction=full_scan_fraction, node_limit=node_limit)
     unseen_pts, sub = pts[unseen], vis[unseen]
     axes = joint_directions(cand, float(pose[3]))
     scans = []

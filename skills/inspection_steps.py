@@ -34,6 +34,7 @@ from py_trees.common import Status
 from py_trees.ports import PortInformation
 
 from ..planners.geometry import path_length, xyz
+from ..planners.scan_points import NODE_LIMIT
 from ..planners.unseen_wall import unseen_wall
 from ..planners.visibility import BodyCameras, line_of_sight
 from .base import AgentContext, Param, ParamNamedPort, Skill
@@ -434,8 +435,8 @@ class ChooseScanPoints(InspectionStep):
         "distance_zoom": Param(bool, True, "zoom each scan for the distance to the surface along its axis"),
         "zoom_step": Param(float, 0.5, "zoom levels are multiples of this (rounded down)",
                            exclusive_minimum=0),
-        "solver_time_limit_s": Param(float, 2.0, "time limit of the exact set cover (CBC, wall clock)",
-                                     exclusive_minimum=0),
+        "solver_node_limit": Param(int, NODE_LIMIT, "branch-and-bound nodes of the exact set cover (CBC): a "
+                                   "work limit, so that the scans do not depend on the machine's speed", minimum=1),
     }
 
     def step(self, job: InspectionJob) -> Status:
@@ -445,7 +446,7 @@ class ChooseScanPoints(InspectionStep):
         plan = plan_inspection(r, record, point=job.point, point_radius_m=job.point_radius_m,
                                joint_grid_deg=self.p["joint_grid_deg"], distance_zoom=self.p["distance_zoom"],
                                zoom_step=self.p["zoom_step"], full_scan_fraction=self.p["full_scan_fraction"],
-                               time_limit_s=self.p["solver_time_limit_s"])
+                               node_limit=self.p["solver_node_limit"])
         sel = plan.selection
         job.unseen_ijk, job.unseen_pts, job.scans = plan.unseen_ijk, plan.unseen_pts, plan.scans
         job.covered = np.zeros(len(job.unseen_pts), dtype=bool)

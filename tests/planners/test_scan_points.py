@@ -131,6 +131,6 @@ def test_paper_sized_instance_is_fast_and_covers():
     bearings = np.stack([rng.uniform(-160, 160, 3000), rng.uniform(-25, 45, 3000)], axis=1)
     vis = ((np.abs(bearings[:, None, 0] - cand[None, :, 0]) <= 30)
            & (np.abs(bearings[:, None, 1] - cand[None, :, 1]) <= 18))
-    sel = select_scan_points(np.zeros((3000, 3)), POSE, cand, vis, 5000, time_limit_s=2.0)
+    sel = select_scan_points(np.zeros((3000, 3)), POSE, cand, vis, 5000, node_limit=2000)
     assert sel.covered_fraction == 1.0 and sel.full_scan and sel.solver in ("cbc", "greedy")
     assert 10 <= sel.n_scan_points <= 20
