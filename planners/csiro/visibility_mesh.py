@@ -47,6 +47,21 @@ def exponential_inversion(points: np.ndarray, agent: np.ndarray, gamma: float) -
     return d * (r ** (gamma - 1.0))[:, None]
 
 
+def behind_observed(sphere: np.ndarray, cloud: np.ndarray, agent: np.ndarray, d_vox_m: float) -> np.ndarray:
+    """(M,) bool: sphere points straight behind an observed point, within half a voxel's angular
+    footprint (d_vox / 2 / range) of the direction of the cloud point nearest in direction. They
+    are hidden, so leaving them out of the hull changes nothing but its cost (in a drift most of
+    the sphere is behind the walls, and qhull takes about a third less time without it)."""
+    d = cloud - agent
+    r = np.linalg.norm(d, axis=1)
+    u = (sphere - agent) / np.linalg.norm(sphere - agent, axis=1)[:, None]
+    gap, near = cKDTree(d / r[:, None]).query(u, distance_upper_bound=0.5 * d_vox_m / r.min())
+    hit = np.isfinite(gap)
+    out = np.zeros(len(sphere), dtype=bool)
+    out[hit] = gap[hit] <= 0.5 * d_vox_m / r[near[hit]]
+    return out
+
+
 def split_long_edges(vertices: np.ndarray, triangles: np.ndarray, frontier_vertex: np.ndarray,
                      eta_disc_m: float, surface: cKDTree | None = None,
                      surface_m: float = 0.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -123,6 +138,7 @@ def visible_mesh(cloud: np.ndarray, agent: np.ndarray,
     if np.linalg.matrix_rank(cloud - cloud.mean(axis=0)) < 3:
         return None, f"degenerate point cloud: the {len(cloud)} points in range lie on one plane"
     sphere = sphere_points(a, params)
+    sphere = sphere[~behind_observed(sphere, cloud, a, params.d_vox_m)]
     points = np.concatenate([cloud, sphere])
     transformed = np.concatenate([exponential_inversion(points, a, params.gamma), np.zeros((1, 3))])
     try:
@@ -166,5 +182,5 @@ def triangle_geometry(mesh: FrontierMesh) -> tuple[np.ndarray, np.ndarray, np.nd
     return centroids, n, 0.5 * twice_area
 
 
-__all__ = ["MIN_POINTS", "exponential_inversion", "sphere_points", "split_long_edges", "triangle_geometry",
+__all__ = ["MIN_POINTS", "behind_observed", "exponential_inversion", "sphere_points", "split_long_edges", "triangle_geometry",
            "visible_mesh"]

@@ -5,7 +5,7 @@ from scipy.spatial import cKDTree
 
 from delve.planners.csiro.params import CsiroFrontierParams
 from delve.planners.csiro.point_cache import PointCache
-from delve.planners.csiro.visibility_mesh import (exponential_inversion, sphere_points, split_long_edges,
+from delve.planners.csiro.visibility_mesh import (behind_observed, exponential_inversion, sphere_points, split_long_edges,
                                                   triangle_geometry, visible_mesh)
 
 from .frontier_clouds import corridor, rectangle, room_with_doorway
@@ -38,6 +38,16 @@ def test_sphere_points_lie_on_d_max_within_the_sensors_elevations_about_a_voxel_
     assert el.min() >= P.elevation_min_deg - 1e-9 and el.max() <= P.elevation_max_deg + 1e-9
     gap, _ = cKDTree(s).query(s, k=2)
     assert gap[:, 1].max() <= P.d_vox_m * 1.01
+
+
+def test_sphere_points_straight_behind_an_observed_point_are_left_out_of_the_hull():
+    wall = rectangle((3.0, -1.05, -1.05), (0, 2, 0), (0, 0, 2))
+    s = sphere_points(np.zeros(3), P)
+    behind = behind_observed(s, wall, np.zeros(3), P.d_vox_m)
+    direction = s / P.d_max_m
+    inside = (direction[:, 0] > 0) & (np.abs(direction[:, 1] / direction[:, 0]) < 0.3) & \
+        (np.abs(direction[:, 2] / direction[:, 0]) < 0.3)
+    assert behind[inside].all() and not behind[direction[:, 0] < 0.2].any()
 
 
 def test_one_long_edge_is_split_at_its_middle_into_a_frontier_point_and_two_triangles():
