@@ -142,6 +142,10 @@ class GraphRobot(RobotBody):
     def take_signal_readings(self) -> list:
         return []
 
+    def take_lidar_scans(self) -> list:
+        """No range sensor on a graph world."""
+        return []
+
     # ---- NetworkView --------------------------------------------------------------
     def topology(self) -> dict[str, Any]:
         """What this robot explored so far, as a plain topology dict."""

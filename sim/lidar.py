@@ -44,6 +44,15 @@ class LidarSpec:
         return np.stack([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)], axis=1)
 
 
+@dataclass(frozen=True)
+class LidarScan:
+    """One sweep of a range sensor: where the sensor was (3,) and the (N, 3) points its beams
+    returned within range, both in the robot's (believed) world frame."""
+
+    sensor: np.ndarray
+    points: np.ndarray
+
+
 #: ANYmal's downward-looking depth cameras, which map the terrain around its feet
 #: (a LiDAR's lowest beam misses the floor of a ramp that falls away).
 TERRAIN_CAMERAS = LidarSpec(vertical_fov_deg=50.0, pitch_deg=-40.0, range_m=4.0, horizontal_resolution_deg=3.0,

@@ -6,6 +6,7 @@
 from __future__ import annotations
 
 import math
+from collections import deque
 from dataclasses import replace
 from typing import TYPE_CHECKING
 
@@ -13,6 +14,7 @@ import numpy as np
 
 from .artifact_sensors import CameraDetection, SignalReading
 from .body import RobotBody
+from .lidar import LidarScan
 from .payload import PanTiltZoomCamera
 from .platforms import Platform
 from .radio import BREADCRUMB_ANTENNA_HEIGHT_M, BreadcrumbDrop
@@ -24,6 +26,8 @@ if TYPE_CHECKING:
     from .world import World
 
 IDLE, FOLLOWING, ARRIVED, BLOCKED = "idle", "following", "arrived", "blocked"
+#: Range-sensor sweeps a robot keeps for ``take_lidar_scans`` (the oldest go first).
+LIDAR_SCANS_KEPT = 20
 _GOLDEN = (math.sqrt(5) - 1) / 2
 
 
@@ -93,6 +97,9 @@ class SimRobot(RobotBody):
         self._drift_mps = np.zeros(3)
 
         self._payload: PanTiltZoomCamera | None = None
+
+        #: Sweeps not yet taken (None until a tree first asks: nothing is kept for trees that never do).
+        self._lidar_scans: deque[LidarScan] | None = None
 
         self._all_sensors = [(spec, spec.beam_directions(0.0))
                              for spec in (platform.lidar, platform.terrain) if spec]
@@ -164,6 +171,15 @@ class SimRobot(RobotBody):
 
     def take_camera_detections(self) -> list[CameraDetection]:
         out, self._detections = self._detections, []
+        return out
+
+    def take_lidar_scans(self) -> list[LidarScan]:
+        """The range sensors' sweeps since the last call, oldest first (at most
+        :data:`LIDAR_SCANS_KEPT`); the first call starts keeping them."""
+        if self._lidar_scans is None:
+            self._lidar_scans = deque(maxlen=LIDAR_SCANS_KEPT)
+        out = list(self._lidar_scans)
+        self._lidar_scans.clear()
         return out
 
     def take_signal_readings(self) -> list[SignalReading]:
@@ -357,4 +373,8 @@ class SimRobot(RobotBody):
             dirs = np.stack([c * beams[:, 0] - s * beams[:, 1], s * beams[:, 0] + c * beams[:, 1], beams[:, 2]], axis=1)
             ranges = self.world.cast_rays(np.broadcast_to(sensor, dirs.shape), dirs, spec.range_m)
             self._map.integrate_scan(sensor + self._drift, dirs, ranges, spec.range_m)
+            if self._lidar_scans is not None:
+                hit = ranges <= spec.range_m
+                at = sensor + self._drift
+                self._lidar_scans.append(LidarScan(at, at + dirs[hit] * ranges[hit, None]))
         self._scans += 1

@@ -112,6 +112,14 @@ class CameraDetection(Protocol):
     rays: np.ndarray
 
 
+class LidarScan(Protocol):
+    """One sweep of a range sensor: where the sensor was (3,) and the (N, 3) points its
+    beams returned within range, in the world frame the robot believes in."""
+
+    sensor: np.ndarray
+    points: np.ndarray
+
+
 class SignalReading(Protocol):
     """One reading of a signal sensor: ``kind`` ``bluetooth`` (``value`` in dBm, the
     beacon's SSID as ``identifier``) or ``co2`` (ppm, no identifier), taken at
@@ -287,6 +295,10 @@ class Robot(Protocol):
 
     def take_signal_readings(self) -> list[SignalReading]:
         """The Bluetooth and CO2 readings since the last call, oldest first."""
+
+    def take_lidar_scans(self) -> list[LidarScan]:
+        """The range sensors' sweeps since the last call, oldest first (the first call
+        starts keeping them; a robot may keep only the latest few)."""
 
 
 class NetworkView(Protocol):

@@ -174,6 +174,8 @@ class FakeRobot:
         #: Artifact readings the next take_* call returns (tests fill them).
         self.camera_detections: list = []
         self.signal_readings: list = []
+        #: Range-sensor sweeps the next take_lidar_scans call returns (tests fill them).
+        self.lidar_scans: list = []
 
     @property
     def position(self) -> np.ndarray:
@@ -199,6 +201,10 @@ class FakeRobot:
 
     def take_signal_readings(self) -> list:
         out, self.signal_readings = self.signal_readings, []
+        return out
+
+    def take_lidar_scans(self) -> list:
+        out, self.lidar_scans = self.lidar_scans, []
         return out
 
     def follow_path(self, path) -> None:
