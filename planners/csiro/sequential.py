@@ -145,21 +145,18 @@ class SequentialFrontiers:
         if mesh is None:
             return FrontierUpdate(self.frontiers, None, reason, (), (), False)
         scene = mesh_scene(mesh)
-        fresh = [f for f in (self._not_seen_before(f) for f in segment_frontiers(mesh, p)) if f is not None]
+        fresh = self._not_seen_before(segment_frontiers(mesh, p), a)
 
         changed_old: list[Frontier] = []       # the old frontiers as they were (for the assignment)
         changed_rest: list[Frontier] = []      # what is left of them (for the clustering)
-        for fid in sorted(self._frontiers):
-            f = self._frontiers[fid]
-            if np.min(np.linalg.norm(f.points - a, axis=1)) > p.d_max_m:
-                continue
-            keep = ~seen_from(f.points, mesh, scene, p)
-            if keep.all():
+        old = [self._frontiers[k] for k in sorted(self._frontiers)]
+        for f, seen in zip(old, self._seen(old, mesh, scene)):
+            if not seen.any():
                 continue
             changed_old.append(f)
-            del self._frontiers[fid]
-            if keep.any():
-                changed_rest.append(_subset(f, keep))
+            del self._frontiers[f.id]
+            if not seen.all():
+                changed_rest.append(_subset(f, ~seen))
 
         clusters = self._cluster(fresh + changed_rest)
         ids = self._assign(changed_old, clusters)
@@ -182,16 +179,29 @@ class SequentialFrontiers:
             self._scenes[k] = mesh_scene(self._viewpoints[k].mesh)
         return self._scenes[k]
 
-    def _not_seen_before(self, f: Frontier) -> Frontier | None:
-        """``f`` without the triangles that a kept viewpoint within range already saw (NotVis)."""
-        keep = np.ones(len(f.points), dtype=bool)
+    def _seen(self, frontiers: list[Frontier], mesh: FrontierMesh,
+              scene: o3d.t.geometry.RaycastingScene) -> list[np.ndarray]:
+        """Vis of every triangle of ``frontiers`` from one viewpoint, in one batch of rays; the
+        test is skipped (all False) for frontiers with no point within d_max of it."""
+        seen = [np.zeros(len(f.points), dtype=bool) for f in frontiers]
+        near = [k for k, f in enumerate(frontiers)
+                if np.min(np.linalg.norm(f.points - mesh.viewpoint, axis=1)) <= self.params.d_max_m]
+        if near:
+            vis = seen_from(np.concatenate([frontiers[k].points for k in near]), mesh, scene, self.params)
+            for k, part in zip(near, np.split(vis, np.cumsum([len(frontiers[k].points) for k in near])[:-1])):
+                seen[k] = part
+        return seen
+
+    def _not_seen_before(self, frontiers: list[Frontier], agent: np.ndarray) -> list[Frontier]:
+        """``frontiers`` (seen from ``agent``, so within d_max of it) without the triangles that a
+        kept viewpoint already saw (NotVis); those left with no triangle are dropped."""
+        keep = [np.ones(len(f.points), dtype=bool) for f in frontiers]
         for k, vp in enumerate(self._viewpoints):
-            if np.min(np.linalg.norm(f.points - vp.position, axis=1)) > self.params.d_max_m:
+            if not frontiers or np.linalg.norm(vp.position - agent) > 2 * self.params.d_max_m:
                 continue
-            keep &= ~seen_from(f.points, vp.mesh, self._scene(k), self.params)
-            if not keep.any():
-                return None
-        return f if keep.all() else _subset(f, keep)
+            for kept, seen in zip(keep, self._seen(frontiers, vp.mesh, self._scene(k))):
+                kept &= ~seen
+        return [f if kept.all() else _subset(f, kept) for f, kept in zip(frontiers, keep) if kept.any()]
 
     def _cluster(self, frontiers: list[Frontier]) -> list[Frontier]:
         """Cluster: the triangles of ``frontiers`` regrown into frontiers (provisional id -1);
