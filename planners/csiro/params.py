@@ -39,8 +39,9 @@ class CsiroFrontierParams:
 
     @property
     def sphere_spacing_rad(self) -> float:
-        """Angular spacing of the sphere points S(a, d_max): one voxel apart at d_max."""
-        return self.d_vox_m / self.d_max_m
+        """Angular spacing of the sphere points S(a, d_max) (the paper gives none): eta_disc / 2
+        apart at d_max, so that even the diagonal between neighbours is no discontinuity."""
+        return 0.5 * self.eta_disc_m / self.d_max_m
 
 
 #: Fields that must be > 0 (distances, areas, times).

@@ -25,8 +25,8 @@ SURFACE_VOXELS = np.sqrt(3.0)
 
 
 def sphere_points(agent: np.ndarray, params: CsiroFrontierParams) -> np.ndarray:
-    """S(a, d_max): points on the sphere of radius d_max around ``agent``, about one voxel
-    (d_vox) apart, at the elevations the sensor sees (elevation_min_deg..elevation_max_deg).
+    """S(a, d_max): points on the sphere of radius d_max around ``agent``, about eta_disc / 2
+    apart, at the elevations the sensor sees (elevation_min_deg..elevation_max_deg).
     Returns (M, 3), rows by elevation then azimuth."""
     step = params.sphere_spacing_rad
     lo, hi = np.radians(params.elevation_min_deg), np.radians(params.elevation_max_deg)

@@ -11,7 +11,7 @@ def test_defaults_are_the_papers_values():
     assert (p.d_vox_m, p.d_max_m, p.eta_subsample_m, p.gamma, p.eta_disc_m, p.eta_area_m2) == \
         (0.3, 9.0, 1.5, -0.018, 0.8, 0.2)
     assert (p.d_min_m, p.t_min_s, p.d_vp_m, p.eta_vis_m) == (1.0, 0.5, 5.0, 0.005)
-    assert math.isclose(p.sphere_spacing_rad, 0.3 / 9.0)
+    assert math.isclose(p.sphere_spacing_rad, 0.4 / 9.0)
 
 
 @pytest.mark.parametrize("field, value, words", [

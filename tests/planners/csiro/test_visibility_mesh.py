@@ -31,13 +31,13 @@ def test_exponential_inversion_keeps_directions_and_maps_range_r_to_r_gamma():
     assert np.linalg.norm(out[1]) > np.linalg.norm(out[0])         # near points land farther out
 
 
-def test_sphere_points_lie_on_d_max_within_the_sensors_elevations_about_a_voxel_apart():
+def test_sphere_points_lie_on_d_max_within_the_sensors_elevations_half_eta_disc_apart():
     s = sphere_points(AGENT, P) - AGENT
     np.testing.assert_allclose(np.linalg.norm(s, axis=1), P.d_max_m)
     el = np.degrees(np.arcsin(s[:, 2] / P.d_max_m))
     assert el.min() >= P.elevation_min_deg - 1e-9 and el.max() <= P.elevation_max_deg + 1e-9
     gap, _ = cKDTree(s).query(s, k=2)
-    assert gap[:, 1].max() <= P.d_vox_m * 1.01
+    assert gap[:, 1].max() <= 0.5 * P.eta_disc_m * 1.01
 
 
 def test_sphere_points_straight_behind_an_observed_point_are_left_out_of_the_hull():
