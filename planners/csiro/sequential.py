@@ -17,6 +17,7 @@ segment's centroids may lie on one plane.
 """
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -83,13 +84,16 @@ def seen_from(points: np.ndarray, mesh: FrontierMesh, scene: o3d.t.geometry.Rayc
     return out
 
 
-def gaussian_kl(mean0: np.ndarray, cov0: np.ndarray, mean1: np.ndarray, cov1: np.ndarray) -> float:
-    """D(N0 || N1), the KL divergence of two 3-D Gaussians (nats)."""
-    inv1 = np.linalg.inv(cov1)
-    dm = mean1 - mean0
-    _, logdet0 = np.linalg.slogdet(cov0)
-    _, logdet1 = np.linalg.slogdet(cov1)
-    return float(0.5 * (np.trace(inv1 @ cov0) + dm @ inv1 @ dm - 3 + logdet1 - logdet0))
+def gaussian_kl(means0: np.ndarray, covs0: np.ndarray, means1: np.ndarray, covs1: np.ndarray) -> np.ndarray:
+    """D(N0_i || N1_j), the KL divergence (nats) of every Gaussian of the first set (means (m, 3),
+    covariances (m, 3, 3)) from every one of the second set (n, ...): an (m, n) array."""
+    inv1 = np.linalg.inv(covs1)
+    logdet0 = np.linalg.slogdet(covs0)[1]
+    logdet1 = np.linalg.slogdet(covs1)[1]
+    dm = means1[None, :, :] - means0[:, None, :]
+    trace = np.einsum("nij,mji->mn", inv1, covs0)
+    mahalanobis = np.einsum("mni,nij,mnj->mn", dm, inv1, dm)
+    return 0.5 * (trace + mahalanobis - 3 + logdet1[None, :] - logdet0[:, None])
 
 
 def _subset(f: Frontier, keep: np.ndarray) -> Frontier:
@@ -163,7 +167,7 @@ class SequentialFrontiers:
         new_ids = []
         for fid, c in zip(ids, clusters):
             if c.area > p.eta_area_m2:
-                self._frontiers[fid] = make_frontier(fid, c.points, c.normals, c.areas)
+                self._frontiers[fid] = dataclasses.replace(c, id=fid)
                 new_ids.append(fid)
         removed = tuple(sorted({f.id for f in changed_old} - set(self._frontiers)))
         created = tuple(sorted(i for i in new_ids if i not in {f.id for f in changed_old}))
@@ -229,7 +233,8 @@ class SequentialFrontiers:
         ids = [-1] * len(new)
         if old and new:
             reg = np.eye(3) * self.params.d_vox_m ** 2 / 12.0
-            cost = np.array([[gaussian_kl(f.mean, f.cov + reg, g.mean, g.cov + reg) for g in new] for f in old])
+            cost = gaussian_kl(np.array([f.mean for f in old]), np.array([f.cov for f in old]) + reg,
+                               np.array([g.mean for g in new]), np.array([g.cov for g in new]) + reg)
             rows, cols = linear_sum_assignment(cost)
             for r, c in zip(rows, cols):
                 if cost[r, c] <= self.params.assignment_max_kl:

@@ -91,7 +91,9 @@ def test_a_point_is_seen_when_it_lies_at_least_eta_vis_in_front_of_the_mesh():
 
 
 def test_kl_divergence_of_gaussians():
-    m, c = np.zeros(3), np.diag([1.0, 2.0, 3.0])
-    assert abs(gaussian_kl(m, c, m, c)) < 1e-12
-    assert np.isclose(gaussian_kl(m, np.eye(3), np.array([2.0, 0, 0]), np.eye(3)), 2.0)
-    assert gaussian_kl(m, c, m + 1, c) > 0
+    m, c = np.zeros((1, 3)), np.diag([1.0, 2.0, 3.0])[None]
+    assert abs(gaussian_kl(m, c, m, c)[0, 0]) < 1e-12
+    kl = gaussian_kl(np.zeros((2, 3)), np.stack([np.eye(3), 2 * np.eye(3)]), np.array([[2.0, 0, 0]]), np.eye(3)[None])
+    assert kl.shape == (2, 1)
+    assert np.isclose(kl[0, 0], 2.0)                                   # |dm|^2 / 2 with unit covariances
+    assert np.isclose(kl[1, 0], 0.5 * (6 + 4 - 3 - 3 * np.log(2)))
