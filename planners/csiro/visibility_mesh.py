@@ -50,8 +50,9 @@ def exponential_inversion(points: np.ndarray, agent: np.ndarray, gamma: float) -
 def behind_observed(sphere: np.ndarray, cloud: np.ndarray, agent: np.ndarray, d_vox_m: float) -> np.ndarray:
     """(M,) bool: sphere points straight behind an observed point, within half a voxel's angular
     footprint (d_vox / 2 / range) of the direction of the cloud point nearest in direction. They
-    are hidden, so leaving them out of the hull changes nothing but its cost (in a drift most of
-    the sphere is behind the walls, and qhull takes about a third less time without it)."""
+    are hidden (give or take half a voxel at the rim of an opening), so leaving them out of the
+    hull changes little but its cost: in a drift most of the sphere is behind the walls, and qhull
+    takes about a third less time without it."""
     d = cloud - agent
     r = np.linalg.norm(d, axis=1)
     u = (sphere - agent) / np.linalg.norm(sphere - agent, axis=1)[:, None]
