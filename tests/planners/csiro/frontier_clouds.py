@@ -29,16 +29,16 @@ def corridor(x0: float, x1: float, width: float = 4.0, height: float = 3.0, *,
     return np.concatenate(parts)
 
 
-def box(lo, hi, *, skip_wall_x: float | None = None, hole: tuple | None = None) -> np.ndarray:
+def box(lo, hi, *, hole_at_x: float | None = None, hole: tuple | None = None) -> np.ndarray:
     """The six walls of the box lo..hi; with ``hole`` = ((y0, y1), (z0, z1)) the wall at
-    x = ``skip_wall_x`` has an opening there."""
+    x = ``hole_at_x`` has an opening there."""
     lo, hi = np.asarray(lo, float), np.asarray(hi, float)
     d = hi - lo
     parts = [rectangle(lo, (d[0], 0, 0), (0, d[1], 0)), rectangle((lo[0], lo[1], hi[2]), (d[0], 0, 0), (0, d[1], 0)),
              rectangle(lo, (d[0], 0, 0), (0, 0, d[2])), rectangle((lo[0], hi[1], lo[2]), (d[0], 0, 0), (0, 0, d[2]))]
     for x in (lo[0], hi[0]):
         wall = rectangle((x, lo[1], lo[2]), (0, d[1], 0), (0, 0, d[2]))
-        if hole is not None and x == skip_wall_x:
+        if hole is not None and x == hole_at_x:
             (y0, y1), (z0, z1) = hole
             inside = (wall[:, 1] > y0) & (wall[:, 1] < y1) & (wall[:, 2] > z0) & (wall[:, 2] < z1)
             wall = wall[~inside]
@@ -51,7 +51,7 @@ def room_with_doorway(open_door: bool = True) -> np.ndarray:
     second room (x 3..7), all of it within 9 m of the origin: the door is an opening, no
     maximum-range frontier."""
     hole = ((-0.6, 0.6), (-1.0, 1.0)) if open_door else None
-    first = box((-3, -3, -1), (3, 3, 2), skip_wall_x=3.0, hole=hole)
+    first = box((-3, -3, -1), (3, 3, 2), hole_at_x=3.0, hole=hole)
     second = box((3, -3, -1), (7, 3, 2))
     second = second[second[:, 0] > 3.0 + 1e-9]       # the shared wall belongs to the first room
     return np.concatenate([first, second])
