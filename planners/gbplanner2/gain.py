@@ -153,29 +153,30 @@ def volumetric_gain(
     gain[out] = tail[0] * omega[out]
 
     active = np.flatnonzero(n_in > 0)
+    # The active rays' directions, sensor voxels and samples inside the grid, kept
+    # compact alongside ``active``.
+    a_dir, a_base, a_nin = ray_dir[active], ray_base[active], n_in[active]
     k0 = 0
     chunk = 8
     while len(active) and k0 < k_max:
         c = min(chunk, k_max - k0)
         table = np.ascontiguousarray(offsets[:, k0:k0 + c])
-        nin = n_in[active]
-        lim = np.minimum(nin - k0, c)  # samples of this chunk inside the grid (>= 1)
-        flat = np.take(table, ray_dir[active], axis=0)
-        flat += ray_base[active, None]
+        lim = np.minimum(a_nin - k0, c)  # samples of this chunk inside the grid (>= 1)
+        flat = np.take(table, a_dir, axis=0)
+        flat += a_base[:, None]
         part = np.flatnonzero(lim < c)
         if len(part):
             # Rays leaving the grid in this chunk: repeat their last inside sample.
-            cols = np.minimum(np.arange(k0, k0 + c)[None, :], (nin[part] - 1)[:, None])
-            flat[part] = offsets[ray_dir[active[part]][:, None], cols] + ray_base[active[part], None]
-        vals = occ[flat]
+            cols = np.minimum(np.arange(k0, k0 + c)[None, :], (a_nin[part] - 1)[:, None])
+            flat[part] = offsets[a_dir[part][:, None], cols] + a_base[part, None]
+        vals = np.take(occ, flat)
         # The first voxel that is not free decides most rays: rock ends them with no
         # gain; only rays whose first such voxel is unknown need a closer look.
-        nonfree = vals != FREE
-        first = nonfree.argmax(axis=1)
-        rows = np.arange(len(active))
-        event = nonfree[rows, first] & (first < lim)
-        ev_unknown = np.flatnonzero(event & (vals[rows, first] == UNKNOWN))
-        hit = event & (vals[rows, first] == OCCUPIED)
+        first = (vals != FREE).argmax(axis=1)
+        first_val = vals.reshape(-1)[np.arange(0, len(active) * c, c) + first]
+        event = (first_val != FREE) & (first < lim)
+        ev_unknown = np.flatnonzero(event & (first_val == UNKNOWN))
+        hit = event & (first_val == OCCUPIED)
         if len(ev_unknown):
             v = vals[ev_unknown]
             h = v == OCCUPIED
@@ -186,13 +187,14 @@ def volumetric_gain(
             sel = active[ev_unknown]
             gain[sel] += (unk.astype(np.float32) @ w[k0:k0 + c]) * omega[sel]
             hit[ev_unknown] = hh
-        done = hit | (nin <= k0 + c)
+        done = hit | (a_nin <= k0 + c)
         # Rays that left the grid without a hit: the rest of their range is unknown.
-        left = done & ~hit & (nin < k_max)
+        left = done & ~hit & (a_nin < k_max)
         if left.any():
             idx = active[left]
             gain[idx] += tail[n_in[idx]] * omega[idx]
-        active = active[~done]
+        more = ~done
+        active, a_dir, a_base, a_nin = active[more], a_dir[more], a_base[more], a_nin[more]
         k0 += c
         chunk = min(chunk * 2, 32)
     return gain.reshape(n, r).sum(axis=1)
