@@ -1,8 +1,9 @@
 """delve.planners.cohort.frontiers: submap wavefronts, the re-check against the common
 map, 26-connected clusters and f_min."""
 import numpy as np
-from delve.planners.cohort import CommonMap, GlobalFrontiers, cluster_frontiers, submap_frontier
-from delve.planners.occupancy import FREE, UNKNOWN
+from delve.planners.cohort import CommonMap, GlobalFrontiers, cluster_frontiers, recheck, submap_frontier
+from delve.planners.cohort.frontiers import near_surface
+from delve.planners.occupancy import FREE, OCCUPIED, UNKNOWN
 
 from .worlds import Z, cut, fork, parallel
 
@@ -68,3 +69,14 @@ def test_clusters_join_at_26_connectivity_and_those_under_f_min_go():
     assert [c.size for c in cluster_frontiers(common, points, f_min=2)] == [5, 2]
     assert [c.size for c in cluster_frontiers(common, points, f_min=5)] == [5]
     assert cluster_frontiers(common, points, f_min=6) == []
+
+
+def test_a_point_next_to_known_rock_is_in_the_surface_band_and_dropped():
+    common = CommonMap((10, 10, 10), np.zeros(3), 0.4, 0.4)
+    common.occupancy[:, :, :5] = FREE
+    common.occupancy[2, 2, 6] = OCCUPIED                                 # one hit above the free space
+    points = np.ravel_multi_index(([2, 2, 7], [2, 3, 7], [5, 5, 5]), common.shape)
+    assert list(near_surface(common, points)) == [True, True, False]
+    assert list(recheck(common, points)) == [points[2]]
+    common.occupancy[7, 7, 5] = FREE                                     # mapped since: deleted as well
+    assert len(recheck(common, points)) == 0
