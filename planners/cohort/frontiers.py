@@ -172,8 +172,3 @@ class GlobalFrontiers:
         if not self.points:
             return np.zeros(0, dtype=np.int64)
         return np.unique(np.concatenate(list(self.points.values())))
-
-    def clusters(self, common: CommonMap, f_min: int) -> list[FrontierCluster]:
-        """Re-check against ``common``, then cluster all points (:func:`cluster_frontiers`)."""
-        self.recheck(common)
-        return cluster_frontiers(common, self.all_points(), f_min)

@@ -53,7 +53,7 @@ def test_a_frontier_point_known_to_another_submap_is_dropped():
     assert len(frontiers.points[("a", 0)]) == 0                          # b mapped past a's end face
     xs = common.centres(frontiers.all_points())[:, 0]
     assert len(xs) and np.all(xs > 39)                                   # b's branch ends remain
-    clusters = frontiers.clusters(common, f_min=10)
+    clusters = cluster_frontiers(common, frontiers.all_points(), f_min=10)
     assert len(clusters) == 2 and {round(c.centroid[1] / 10) for c in clusters} == {1, 3}
 
 
