@@ -262,7 +262,11 @@ def _connect(local_map: LocalMap, pts: np.ndarray, hang: np.ndarray, cfg: GBPlan
     keep = np.isfinite(dist) & (nbr != src) & (nbr < n)
     a, b = src[keep], nbr[keep]
     lo, hi = np.minimum(a, b), np.maximum(a, b)
-    codes = np.unique(lo.astype(np.int64) * n + hi)
+    # The distinct pairs, by sorting: np.unique (hashing first) takes about twice as long.
+    codes = np.sort(lo.astype(np.int64) * n + hi)
+    first = np.ones(len(codes), bool)
+    first[1:] = codes[1:] != codes[:-1]
+    codes = codes[first]
     ei, ej = codes // n, codes % n
     # Edges between two hanging vertices can never be used.
     both_hanging = hang[ei] & hang[ej]
