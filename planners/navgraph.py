@@ -219,16 +219,28 @@ def _same_height_near(ground: np.ndarray, query: np.ndarray, radius_cells: float
 
 def _inclination_deg(cand: Voxels, vox: float, limit_deg: float, baseline_m: float) -> np.ndarray:
     """Ground inclination at each standable voxel from neighbours ``baseline_m`` away."""
-    b = max(1, int(round(baseline_m / vox)))
-    search = max(2, math.ceil(b * math.tan(math.radians(min(limit_deg + 15, 80)))))
-    heights = {}
     with _Lookup(int(np.prod(cand.shape)), cand.flat) as ids:
-        for di, dj in ((b, 0), (-b, 0), (0, b), (0, -b)):
-            h = np.full(len(cand), np.nan)
-            for dz in sorted(range(-search, search + 1), key=abs):
-                hit = (cand.at(ids, (di, dj, dz), 0) > 0) & np.isnan(h)
-                h[hit] = dz
-            heights[(di, dj)] = h
+        return inclination_among(cand, ids, vox, limit_deg, baseline_m)
+
+
+def inclination_reach(vox: float, limit_deg: float, baseline_m: float) -> tuple[int, int]:
+    """How far (voxels: horizontally, vertically) :func:`inclination_among` looks."""
+    b = max(1, int(round(baseline_m / vox)))
+    return b, max(2, math.ceil(b * math.tan(math.radians(min(limit_deg + 15, 80)))))
+
+
+def inclination_among(query: Voxels, standable: np.ndarray, vox: float, limit_deg: float,
+                      baseline_m: float) -> np.ndarray:
+    """Ground inclination at each ``query`` voxel from the standable voxels (nonzero in
+    ``standable``, a flat array over the grid) ``baseline_m`` away."""
+    b, search = inclination_reach(vox, limit_deg, baseline_m)
+    heights = {}
+    for di, dj in ((b, 0), (-b, 0), (0, b), (0, -b)):
+        h = np.full(len(query), np.nan)
+        for dz in sorted(range(-search, search + 1), key=abs):
+            hit = (query.at(standable, (di, dj, dz), 0) > 0) & np.isnan(h)
+            h[hit] = dz
+        heights[(di, dj)] = h
     grads = []
     for plus, minus in (((b, 0), (-b, 0)), ((0, b), (0, -b))):
         hp, hm = heights[plus], heights[minus]

@@ -7,11 +7,33 @@ a ray ends in becomes OCCUPIED. Sensing is exact, so no log-odds are needed.
 
 from __future__ import annotations
 
+import weakref
+
 import numpy as np
 
 UNKNOWN = -1
 FREE = 0
 OCCUPIED = 1
+
+
+class ChangeLog:
+    """One consumer's record of the voxels a map changed since the consumer last took
+    them (a planner that updates its results incrementally); independent of
+    ``take_changes`` and of other consumers' logs. Keeps the arrays of flat indices
+    the map recorded, so a record costs no copy."""
+
+    __slots__ = ("_parts", "__weakref__")
+
+    def __init__(self) -> None:
+        self._parts: list[np.ndarray] = []
+
+    def record(self, flat: np.ndarray) -> None:
+        self._parts.append(flat)
+
+    def take(self) -> np.ndarray:
+        """Flat indices (ascending, distinct) of the voxels changed since the last take."""
+        parts, self._parts = self._parts, []
+        return np.unique(np.concatenate(parts)) if parts else np.zeros(0, dtype=np.int64)
 
 
 class VoxelMap:
@@ -36,6 +58,7 @@ class VoxelMap:
         self._new_free: list[np.ndarray] = []
         self._free_stale = False
         self._refreed = False
+        self._logs: weakref.WeakSet[ChangeLog] = weakref.WeakSet()
 
     @property
     def shape(self) -> tuple[int, int, int]:
@@ -89,6 +112,18 @@ class VoxelMap:
     def _touch(self, flat: np.ndarray) -> None:
         """Record voxels ``flat`` as changed."""
         np.bitwise_or.at(self._dirty, flat >> 3, np.left_shift(1, flat & 7).astype(np.uint8))
+        self._log(flat)
+
+    def _log(self, flat: np.ndarray) -> None:
+        """Record voxels ``flat`` as changed in every consumer's change log."""
+        for log in self._logs:
+            log.record(flat)
+
+    def change_log(self) -> ChangeLog:
+        """A new consumer's log of the voxels that change from now on (:class:`ChangeLog`)."""
+        log = ChangeLog()
+        self._logs.add(log)
+        return log
 
     def set_sphere(self, centre: np.ndarray, radius_m: float, value: int) -> None:
         """Set every voxel within ``radius_m`` of ``centre`` to ``value``."""
@@ -140,6 +175,7 @@ class VoxelMap:
         merged = np.maximum(current, values)
         self._new_free.append(flat[(current == UNKNOWN) & (merged == FREE)])
         self._free_stale = True
+        self._log(flat[merged != current])
         occ[flat] = merged
         self.version += 1
 

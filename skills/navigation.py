@@ -3,7 +3,8 @@
 The :class:`Navigator` keeps the navigation graph of the robot's onboard map and the
 shortest-path tree from the robot, and rebuilds them when the map has changed and
 they are older than ``rebuild_period_s`` (10 s) of sim time, so that several skills ticking
-in one agent do not plan twice.
+in one agent do not plan twice. A legged robot's graph is updated from the voxels that
+changed since the last build (the map's change log), not rebuilt over the whole map.
 """
 from __future__ import annotations
 
@@ -11,10 +12,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..planners.navgraph import NavGraph, aerial_graph, legged_graph
+from ..planners.navgraph import NavGraph, aerial_graph
+from ..planners.navgraph_incremental import LeggedGraphUpdater
 from ..planners.occupancy import Grid
 from .base import AgentContext
-from .robot import Robot
+from .robot import ChangeLog, Robot
 
 
 @dataclass(frozen=True)
@@ -44,6 +46,7 @@ class Navigator:
         self._plan: Plan | None = None
         self._plan_key: tuple[int, int] | None = None
         self.builds = 0
+        self._legged: tuple[object, ChangeLog, LeggedGraphUpdater] | None = None
 
     def grid(self) -> Grid:
         m = self.robot.onboard_map
@@ -62,16 +65,21 @@ class Navigator:
                 self._graph = aerial_graph(self.grid(), radius_m=mob.radius_m)
 
             else:
-                self._graph = legged_graph(
-                    self.grid(),
-                    body_height_m=mob.body_height_m,
-                    radius_m=mob.radius_m,
-                    max_step_m=mob.max_step_m,
-                    max_inclination_deg=mob.max_inclination_deg,
-                )
+                self._graph = self._legged_graph()
             self._graph_key = (version, now)
             self.builds += 1
         return self._graph
+
+    def _legged_graph(self) -> NavGraph:
+        """The legged graph of the current map, updated from the voxels changed since the
+        last build (built over the whole map the first time, or for a new map object)."""
+        m, mob = self.robot.onboard_map, self.robot.mobility
+        if self._legged is None or self._legged[0] is not m:
+            updater = LeggedGraphUpdater(body_height_m=mob.body_height_m, radius_m=mob.radius_m,
+                                         max_step_m=mob.max_step_m, max_inclination_deg=mob.max_inclination_deg)
+            self._legged = (m, m.change_log(), updater)
+            return updater.update(self.grid())
+        return self._legged[2].update(self.grid(), self._legged[1].take())
 
     def map_changed(self) -> bool:
         """Whether the map has changed since the graph was built (a forced rebuild would differ)."""

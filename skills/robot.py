@@ -60,6 +60,17 @@ class MapView(Protocol):
 
         """Flat voxel indices and values changed since the last call (for map sharing)."""
 
+    def change_log(self) -> ChangeLog:
+        """A new log of the voxels that change from now on, for one consumer (a planner
+        that updates its results incrementally), independent of ``take_changes``."""
+
+
+class ChangeLog(Protocol):
+    """One consumer's log of a map's changed voxels (:meth:`MapView.change_log`)."""
+
+    def take(self) -> np.ndarray:
+        """Flat indices (ascending) of the voxels changed since the last take."""
+
 
 class Message(Protocol):
     """A radio message: who sent it, to whom, what kind, its payload and when (sim s).

@@ -109,3 +109,21 @@ def test_change_log_holds_the_last_voxel_of_the_grid():
     flat, values = m.take_changes()
     assert flat.tolist() == [26] and values.tolist() == [OCCUPIED]
     assert m._dirty.nbytes == 8                      # 27 voxels, one bit each, in a 64-bit word
+
+
+def test_each_consumers_change_log_holds_scans_resets_and_merges_since_its_last_take():
+    m = VoxelMap((20, 5, 5), np.zeros(3), 0.2)
+    early = m.change_log()
+    m.integrate_scan(np.array([0.1, 0.5, 0.5]), np.array([[1.0, 0, 0]]), np.array([2.0]), 3.5)
+    late = m.change_log()
+    first = early.take()
+    assert np.array_equal(first, np.sort(np.flatnonzero(m.occupancy.reshape(-1) != UNKNOWN)))
+    assert len(late.take()) == 0 and len(early.take()) == 0       # taken once; late came after the scan
+    before = m.occupancy.copy()
+    m.set_sphere(np.array([1.0, 0.5, 0.5]), 0.3, UNKNOWN)
+    m.merge(np.array([0, 99]), np.array([OCCUPIED, FREE], np.int8))
+    m.take_changes()                                               # map sharing does not empty the logs
+    changed = np.flatnonzero((m.occupancy != before).reshape(-1))
+    for log in (early, late):
+        got = log.take()
+        assert np.all(np.isin(changed, got)) and np.array_equal(got, np.unique(got))

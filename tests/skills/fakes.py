@@ -13,6 +13,7 @@ import py_trees
 import yaml
 from delve.executive.tree_loader import build_tree
 from delve.planners.occupancy import FREE, UNKNOWN, Grid
+from delve.sim.voxel_map import ChangeLog
 from delve.skills.base import AgentContext
 from delve.skills.robot import PathStatus
 from py_trees.common import Status
@@ -45,6 +46,7 @@ class FakeMap:
         self.occupancy, self.origin, self.voxel_size_m, self.version = grid.occupancy, grid.origin, grid.voxel_size_m, 1
         self._own = False
         self._changed: dict[int, int] = {}
+        self._logs: list[ChangeLog] = []
 
     def free_voxels(self) -> np.ndarray:
         return np.flatnonzero(self.occupancy.reshape(-1) == FREE)
@@ -61,7 +63,14 @@ class FakeMap:
             self.occupancy, self._own = self.occupancy.copy(), True
         self.occupancy.reshape(-1)[flat] = values
         self._changed.update(zip(flat.tolist(), values.tolist()))
+        for log in self._logs:
+            log.record(flat)
         self.version += 1
+
+    def change_log(self) -> ChangeLog:
+        log = ChangeLog()
+        self._logs.append(log)
+        return log
 
     def take_changes(self) -> tuple[np.ndarray, np.ndarray]:
         flat = np.array(sorted(self._changed), np.int64)

@@ -1,0 +1,188 @@
+"""The legged navigation graph kept up to date from the voxels that changed.
+
+:func:`delve.planners.navgraph.legged_graph` rebuilds the graph over every free voxel
+of the map. Whether a voxel is a node, though, depends only on the map a few voxels
+around it, and a node's edges on the nodes next to it. :class:`LeggedGraphUpdater`
+keeps, per voxel, what each rule of ``legged_graph`` concluded (rock, ground, standable,
+node) and the edges by voxel; an update follows a change through the rules, recomputing
+a rule only where one of its inputs changed (a LiDAR sweep frees thousands of voxels of
+air, which change no node), then numbers the nodes as the full build does (in the
+map's order of free voxels), so the graph equals ``legged_graph``'s exactly.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy.sparse import csr_matrix
+
+from .navgraph import _NEIGHBOURS_8, NavGraph, Voxels, _Lookup, inclination_among, inclination_reach
+from .occupancy import FREE, OCCUPIED, UNKNOWN, Grid
+
+
+class LeggedGraphUpdater:
+    """The legged navigation graph of one map, updated from its changed voxels.
+
+    Takes the parameters of :func:`delve.planners.navgraph.legged_graph`. Memory: four
+    bytes per voxel of the grid (zero-filled, so only the pages around the mapped space
+    are backed) and the edges.
+    """
+
+    def __init__(self, *, body_height_m: float, radius_m: float, max_step_m: float, max_inclination_deg: float,
+                 headroom_m: float | None = None, inclination_baseline_m: float = 0.6,
+                 ground_inference_radius_m: float = 1.0):
+        self.body_height_m, self.radius_m, self.max_step_m = body_height_m, radius_m, max_step_m
+        self.max_inclination_deg, self.inclination_baseline_m = max_inclination_deg, inclination_baseline_m
+        self.headroom_m = body_height_m + 0.2 if headroom_m is None else headroom_m
+        self.ground_inference_radius_m = ground_inference_radius_m
+        self._shape: tuple[int, int, int] | None = None
+
+    def _setup(self, grid: Grid) -> None:
+        """The rules' offsets for this grid's voxel size, and empty per-voxel state (that
+        of a map with every voxel unknown)."""
+        vox, size = grid.voxel_size_m, int(np.prod(grid.shape))
+        self._shape, self._vox = grid.shape, vox
+        #: What the rules concluded per voxel: rock, free with rock below (ground),
+        #: standable (ground below or beside, headroom above), node.
+        self.rock, self.ground = np.zeros(size, np.uint8), np.zeros(size, np.uint8)
+        self.standable, self.node = np.zeros(size, np.uint8), np.zeros(size, np.uint8)
+        self._edges = (np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0))
+        self.n_up = max(1, math.ceil(self.headroom_m / vox) - 1)
+        radius = self.ground_inference_radius_m / vox
+        span = range(-math.ceil(radius), math.ceil(radius) + 1)
+        self._disc = [(a, b, 0) for a in span for b in span if math.hypot(a, b) <= radius + 1e-9]
+        r = max(1, int(round(self.radius_m / vox)))
+        layers = sorted({1, max(1, self.n_up // 2), self.n_up})
+        self._body = [(di, dj, c) for di in range(-r, r + 1) for dj in range(-r, r + 1)
+                      if (di, dj) != (0, 0) and di * di + dj * dj <= r * r for c in layers]
+        self.max_dz = max(1, int(math.floor(self.max_step_m / vox + 1e-9)))
+        steps = range(-self.max_dz, self.max_dz + 1)
+        self._offsets = [(di, dj, dz) for di, dj in _NEIGHBOURS_8 if (di, dj) > (0, 0) for dz in steps]
+        self._sides = [(di, dj, dz) for di, dj in ((1, 0), (-1, 0), (0, 1), (0, -1)) for dz in steps]
+        b, search = inclination_reach(vox, self.max_inclination_deg, self.inclination_baseline_m)
+        self._slope = [(di, dj, dz) for di, dj in ((b, 0), (-b, 0), (0, b), (0, -b)) for dz in range(-search, search + 1)]
+
+    # -- the rules of legged_graph, per voxel ---------------------------------------------
+    def _standable(self, occ: np.ndarray, q: Voxels) -> np.ndarray:
+        """Which ``q`` voxels (free) stand on ground, or where the voxel below is unknown,
+        beside ground at the same height, and have headroom (as legged_graph)."""
+        below = q.at(occ, (0, 0, -1), UNKNOWN)
+        stand = below == OCCUPIED
+        unknown = np.flatnonzero(below == UNKNOWN)
+        beside = np.zeros(len(unknown), dtype=bool)
+        for d in self._disc:
+            beside |= q.at(self.ground, d, 0, unknown) > 0
+        stand[unknown[beside]] = True
+        for c in range(1, self.n_up + 1):
+            stand &= q.at(occ, (0, 0, c), OCCUPIED) != OCCUPIED
+        return stand
+
+    def _nodes(self, occ: np.ndarray, q: Voxels) -> np.ndarray:
+        """Which ``q`` voxels (standable) are nodes: gentle ground, no rock by the body."""
+        keep = inclination_among(q, self.standable, self._vox, self.max_inclination_deg,
+                                 self.inclination_baseline_m) <= self.max_inclination_deg
+        for d in self._body:
+            keep &= q.at(occ, d, OCCUPIED) != OCCUPIED
+        return keep
+
+    def _edges_from(self, q: Voxels) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Edges (source flat, target flat, length) from the ``q`` voxels (nodes), as
+        :func:`delve.planners.navgraph._graph` makes them with ``side_steps``."""
+        sides: dict[tuple[int, int], np.ndarray] = {}
+
+        def beside(di: int, dj: int) -> np.ndarray:
+            if (di, dj) not in sides:
+                sides[(di, dj)] = np.logical_or.reduce(
+                    [q.at(self.node, (di, dj, dz), 0) > 0 for dz in range(-self.max_dz, self.max_dz + 1)])
+            return sides[(di, dj)]
+
+        src, dst, w = [], [], []
+        ny, nz = self._shape[1], self._shape[2]
+        for d in self._offsets:
+            ok = q.at(self.node, d, 0) > 0
+            if d[0] and d[1]:
+                ok &= beside(d[0], 0) & beside(0, d[1])
+            s = q.flat[ok]
+            src.append(s)
+            dst.append(s + (d[0] * ny + d[1]) * nz + d[2])
+            w.append(np.full(len(s), self._vox * math.sqrt(d[0] ** 2 + d[1] ** 2 + d[2] ** 2)))
+        return np.concatenate(src), np.concatenate(dst), np.concatenate(w)
+
+    # -- updates ------------------------------------------------------------------------------
+    def update(self, grid: Grid, changed: np.ndarray | None = None) -> NavGraph:
+        """The graph of ``grid`` after the voxels ``changed`` (flat indices) changed since
+        the last update; from every known voxel when ``changed`` is None or on the first
+        update (or for a grid of another shape)."""
+        occ = grid.occupancy.reshape(-1)
+        if changed is None or self._shape != grid.shape:
+            self._setup(grid)
+            changed = np.flatnonzero(occ != UNKNOWN)
+        changed = np.asarray(changed, dtype=np.int64)
+        rock = self._set(self.rock, changed, occ[changed] == OCCUPIED)
+        ground = self._around(changed, [(0, 0, 0), (0, 0, 1)])
+        q = Voxels(ground, grid.shape)
+        ground = self._set(self.ground, ground, (occ[ground] == FREE) & (q.at(occ, (0, 0, -1), UNKNOWN) == OCCUPIED))
+        stand = self._distinct(np.concatenate([self._around(changed, [(0, 0, 0), (0, 0, 1)]), self._around(ground, self._disc),
+                                          self._around(rock, [(0, 0, -c) for c in range(1, self.n_up + 1)])]))
+        stand = self._set(self.standable, stand, self._where_free(occ, stand, self._standable))
+        node = self._distinct(np.concatenate([self._around(stand, [(0, 0, 0)] + [tuple(-a for a in d) for d in self._slope]),
+                                         self._around(rock, [tuple(-a for a in d) for d in self._body])]))
+        node = self._set(self.node, node, self._where_free(occ, node, self._nodes, among=self.standable))
+        sources = self._around(node, [(0, 0, 0)] + [tuple(-a for a in d) for d in self._offsets + self._sides])
+        src, dst, w = self._edges
+        with _Lookup(len(self.node), sources) as redo:
+            keep = redo[src] == 0
+        q = Voxels(sources, grid.shape)
+        new = self._edges_from(q.subset(self.node[sources] > 0))
+        self._edges = src, dst, w = (np.concatenate([src[keep], new[0]]), np.concatenate([dst[keep], new[1]]),
+                                     np.concatenate([w[keep], new[2]]))
+        return self._graph(grid, src, dst, w)
+
+    def _where_free(self, occ: np.ndarray, flat: np.ndarray, rule, among: np.ndarray | None = None) -> np.ndarray:
+        """A rule's conclusion for the voxels ``flat``: False where a voxel is not free (or
+        not in ``among``), else the rule's."""
+        out = occ[flat] == FREE
+        if among is not None:
+            out &= among[flat] > 0
+        out[out] = rule(occ, Voxels(flat[out], self._shape))
+        return out
+
+    @staticmethod
+    def _set(state: np.ndarray, flat: np.ndarray, value: np.ndarray) -> np.ndarray:
+        """Store a rule's conclusions for the voxels ``flat``; the voxels where they changed."""
+        value = value.astype(np.uint8)
+        changed = flat[state[flat] != value]
+        state[flat] = value
+        return changed
+
+    def _around(self, flat: np.ndarray, offsets: list[tuple[int, int, int]]) -> np.ndarray:
+        """The distinct voxels (flat, inside the grid) at ``offsets`` from the voxels ``flat``."""
+        v = Voxels(flat, self._shape)
+        ny, nz = self._shape[1], self._shape[2]
+        parts = []
+        for d in offsets:
+            target = v.flat + (d[0] * ny + d[1]) * nz + d[2]
+            near = np.flatnonzero(v.margin < max(abs(d[0]), abs(d[1]), abs(d[2])))
+            if len(near):
+                t = v.ijk[near] + np.array(d)
+                out = ~np.all((t >= 0) & (t < np.array(self._shape)), axis=1)
+                target = np.delete(target, near[out])
+            parts.append(target)
+        return self._distinct(np.concatenate(parts)) if parts else flat
+
+    def _distinct(self, flat: np.ndarray) -> np.ndarray:
+        """The distinct values of ``flat`` (voxels' flat indices), found with the shared
+        voxel -> position lookup (a scatter and a gather: faster than sorting)."""
+        with _Lookup(len(self.node), flat) as at:
+            return flat[at[flat] == np.arange(1, len(flat) + 1)]
+
+    def _graph(self, grid: Grid, src: np.ndarray, dst: np.ndarray, w: np.ndarray) -> NavGraph:
+        """The nodes in the map's order of free voxels, numbered, and their edges."""
+        free = Voxels.free_of(grid)
+        nodes = free.subset(self.node[free.flat] > 0)
+        positions = grid.to_world(nodes.ijk)
+        positions[:, 2] += self.body_height_m - 0.5 * self._vox
+        n = len(nodes)
+        with _Lookup(len(self.node), nodes.flat) as ids:
+            rows, cols = ids[src].astype(np.int64) - 1, ids[dst].astype(np.int64) - 1
+        return NavGraph(positions=positions, adjacency=csr_matrix((w, (rows, cols)), shape=(n, n)))
