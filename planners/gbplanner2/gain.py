@@ -152,7 +152,10 @@ def volumetric_gain(
     out = np.repeat(~inside0, r)
     gain[out] = tail[0] * omega[out]
 
-    active = np.flatnonzero(n_in > 0)
+    # Rays are marched sensor by sensor in the order of their voxels in memory, so
+    # that neighbouring sensors read neighbouring voxels while they are in the cache.
+    by_voxel = (np.argsort(base, kind="stable")[:, None] * r + np.arange(r)).reshape(-1)
+    active = by_voxel[n_in[by_voxel] > 0]
     # The active rays' directions, sensor voxels and samples inside the grid, kept
     # compact alongside ``active``.
     a_dir, a_base, a_nin = ray_dir[active], ray_base[active], n_in[active]
@@ -178,6 +181,8 @@ def volumetric_gain(
         ev_unknown = np.flatnonzero(event & (first_val == UNKNOWN))
         hit = event & (first_val == OCCUPIED)
         if len(ev_unknown):
+            # In the order of the rays (the float32 sums below depend on the batch).
+            ev_unknown = ev_unknown[np.argsort(active[ev_unknown], kind="stable")]
             v = vals[ev_unknown]
             h = v == OCCUPIED
             fh = h.argmax(axis=1)
