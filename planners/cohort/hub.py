@@ -131,8 +131,10 @@ class CohortHub:
                    request_id: int = 0) -> Reposition:
         """Answer ``robot``'s call from ``position``: :func:`choose_frontier` with every
         robot's last known position and home as Dijkstra sources, leaving out the
-        clusters that share points with another robot's latest assignment. Recomputes
-        the frontiers first when a submap arrived since. The answer is recorded."""
+        clusters that share points with another robot's latest assignment while it
+        holds (T_C + T_C^e after it was given: a robot that has not called again by
+        then has gone home or lost its way back). Recomputes the frontiers first when
+        a submap arrived since. The answer is recorded."""
         if self.stale:
             self.update_frontiers()
         self.robot_positions[robot] = np.asarray(position, float).copy()
@@ -141,9 +143,10 @@ class CohortHub:
         if self.home is not None:
             sources[HOME] = self.home
         entries = {name: self.graph.attach(p, fine, self.common, radius) for name, p in sources.items()}
+        live = [rec.points for other, rec in self.last_assignment.items()
+                if other != robot and t_s - rec.t_s <= self.params.period_s + self.params.extra_explore_s]
         taken = {i for i, c in enumerate(self.clusters)
-                 for other, rec in self.last_assignment.items()
-                 if other != robot and len(np.intersect1d(c.voxels, rec.points, assume_unique=True))}
+                 if any(len(np.intersect1d(c.voxels, pts, assume_unique=True)) for pts in live)}
         lo, hi = self.common.bounds
         result = choose_frontier(self.graph, self.clusters, self.links, entries, robot,
                                  best_share_pct=self.params.best_share_pct, box_m=self.params.box_m,

@@ -12,10 +12,11 @@ Choices where the paper is silent:
   source is the least, over those vertices, of the path length to the vertex plus the
   straight line from it to the cluster's centroid. Clusters the calling robot cannot
   reach on G_C are left out before the best n_C % are taken.
-* A cluster another robot was sent to (by its last assignment) is left out while
-  others remain, so two robots asking from the same place are not sent to one
-  frontier; the distances from every robot are what tells which robot a cluster
-  is closer to, and are logged with the decision.
+* A cluster another robot was sent to (``taken``: the hub passes the clusters of the
+  other robots' latest assignments that still hold) is left out while others remain,
+  so two robots asking from the same place are not sent to one frontier. The
+  distances from every robot and home to the chosen cluster come with the answer
+  (``distances_m``) and are logged.
 * The box is centred on the centroid and clipped to the world (a box of 360 m in a
   smaller world is the world).
 """

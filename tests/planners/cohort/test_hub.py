@@ -46,6 +46,15 @@ def test_two_robots_at_the_fork_are_sent_to_different_branches():
     assert hub.last_assignment["b"].result is rb
 
 
+def test_an_assignment_holds_its_cluster_for_t_c_plus_t_c_e():
+    hub, fine = hub_after(TRUNK, JUNCTION)
+    at = np.array([30, 20, Z])
+    ra = hub.reposition(fine, "a", at, 10.0)
+    held = 10.0 + PARAMS.period_s + PARAMS.extra_explore_s
+    assert hub.reposition(fine, "b", at, held).cluster != ra.cluster
+    assert hub.reposition(fine, "b", at, held + 1.0).cluster == ra.cluster
+
+
 def test_no_frontier_before_any_submap():
     truth = fork()
     _, fine = base_map(truth)
