@@ -120,6 +120,10 @@ class TopometricMap:
     def position(self, node: Node) -> np.ndarray:
         return self.graph.nodes[node]["pos"]
 
+    def last_node(self, robot: str) -> Node | None:
+        """``robot``'s newest trajectory node; None before its first."""
+        return self._last.get(robot)
+
     def trajectory_nodes(self) -> list[Node]:
         """Every trajectory node, in a fixed order (robot, k)."""
         return sorted(n for n in self.graph if n[0] != "frontier")

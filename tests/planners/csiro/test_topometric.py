@@ -30,6 +30,7 @@ def test_nodes_every_spacing_joined_along_the_trajectory():
     assert len(nodes) == 11 and np.allclose(np.diff(xs), 3.0)
     assert all(m.graph.has_edge(p, q) for p, q in zip(nodes[:-1], nodes[1:]))
     assert m.add_pose("a", 100.0, [31.0, 0, 0]) is None        # within 3 m of the last node
+    assert m.last_node("a") == nodes[-1] and m.last_node("b") is None
 
 
 def test_distances_and_astar_path_follow_the_trajectory_not_the_straight_line():
