@@ -117,7 +117,7 @@ class Scenario:
 
     def check_starts(self, world: Any) -> None:
         """Each robot's start pose must be inside the world and in free space, and so
-        must each listed artifact."""
+        must each listed artifact; the team strategy's parameters must fit the world."""
         for r in self.robots:
             if r.start is None:
                 continue
@@ -132,6 +132,7 @@ class Scenario:
                                  self.doc["base_station"].key_line("position"))
         if self.artifacts is not None:
             self.artifacts.listed(world)
+        self.team.strategy.check_world(self, world)
 
 
 def _where(path: Any) -> str:
@@ -298,6 +299,17 @@ def _team(doc: YamlDict, path: Path, tree_types: set[type]) -> TeamSpec:
     return TeamSpec(strategy, params)
 
 
+def _check_hub_needed(doc: YamlDict, path: Path, robots: list[RobotSpec], robot_types: dict[str, set[type]]) -> None:
+    """A robot tree whose behaviours belong to a strategy that needs a base station
+    tree, in a scenario with neither: a mistake at that robot's ``tree:`` line."""
+    for i, r in enumerate(robots):
+        name = implied_strategy(robot_types[r.name])
+        if name is not None and TEAM_STRATEGIES[name].NEEDS_BASE_TREE:
+            raise DelveError(f"robot {short_repr(r.name)}: its tree uses behaviours of team strategy {name!r}, which "
+                             f"needs a base station tree (base_station: tree: ...) and 'team: {{strategy: {name}}}'",
+                             path, doc["robots"][i].key_line("tree"))
+
+
 def _artifacts(doc: YamlDict, path: Path, backend: type[WorldBackend], tree_types: set[type]) -> ArtifactSetup | None:
     """The scenario's ``artifacts:`` section: only on worlds that hide artifacts; a
     warning when no tree submits reports (nothing could score)."""
@@ -369,6 +381,8 @@ def load_scenario(path: str | Path, include_path: Iterable[str | Path] = (),
     _check_steps(doc, path, float(values["duration_s"]), float(values["dt_s"]))
     warn_late_events(doc, path, float(values["duration_s"]))
     backend.check(doc, path, base_tree is not None)
+    if base_tree is None and "team" not in doc:
+        _check_hub_needed(doc, path, robots, robot_types)
     team = _team(doc, path, tree_types)
     artifacts = _artifacts(doc, path, backend, tree_types)
     if team.strategy.NEEDS_BASE_TREE and base_tree is None:

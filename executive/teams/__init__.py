@@ -7,6 +7,7 @@ is a module that subclasses :class:`TeamStrategy` and calls :func:`register_team
 from __future__ import annotations
 
 from .base import TeamStrategy
+from .cohort import Cohort
 from .cops import Cops
 from .independent import Independent
 
@@ -34,6 +35,7 @@ def wall_clock_fields() -> tuple[str, ...]:
 
 register_team("independent", Independent)
 register_team("cops", Cops)
+register_team("cohort", Cohort)
 
 __all__ = ["DEFAULT_STRATEGY", "TEAM_STRATEGIES", "TeamStrategy", "implied_strategy", "register_team",
            "wall_clock_fields"]

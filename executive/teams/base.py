@@ -18,6 +18,7 @@ from ...skills.base import Param
 if TYPE_CHECKING:
     from ..agent import Agent
     from ..runner import Mission
+    from ..scenario import Scenario
 
 
 class TeamStrategy(ABC):
@@ -43,6 +44,11 @@ class TeamStrategy(ABC):
         """Whether a scenario without ``team:`` whose base station tree has nodes of
         ``base_tree_types`` meant this strategy (scenarios from before ``team:``)."""
         return False
+
+    @classmethod
+    def check_world(cls, scenario: "Scenario", world: Any) -> None:
+        """Check the strategy's parameters against the built world (its size, say); a
+        :class:`~delve.executive.errors.DelveError` with the scenario's line if wrong."""
 
     def robot_services(self, name: str) -> dict[str, Any]:
         """Services of robot ``name``'s agent, given before its tree is built."""
@@ -89,6 +95,9 @@ class TeamStrategy(ABC):
         with one."""
         voxels = mission.backend.map_undelivered(name)
         return {} if voxels is None else {"map_voxels_undelivered": voxels}
+
+    def draw(self, ax: Any, mission: "Mission") -> None:
+        """Draw what the strategy decided on the top-down ``map.png`` (matplotlib axes)."""
 
     def wall_clock_figures(self, mission: "Mission") -> dict[str, Any]:
         """This strategy's figures that depend on the wall clock (``WALL_CLOCK_FIELDS``)."""

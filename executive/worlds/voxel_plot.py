@@ -72,6 +72,7 @@ def plot_voxel_map(mission: "Mission", truth_voxels: np.ndarray, path: Path) -> 
         ax.plot(pos[linked, 0], pos[linked, 1], "o", ms=3, color="green", label="radio link to base" if i == 0 else None)
     ax.plot(*mission.base_position[:2], "k^", ms=9, label="base station")
     mission.artifacts.draw(ax, mission)
+    mission.team.draw(ax, mission)
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
     ax.set_title(f"{mission.scenario.name}: team coverage {mission.state.samples[-1].team:.0%}")
