@@ -35,14 +35,19 @@ def grow_regions(adjacency: csr_matrix, centroids: np.ndarray, eta_dia_m: float)
     bounds = np.searchsorted(comp[order], np.arange(n_comp + 1))
     for c in range(n_comp):
         members = order[bounds[c]:bounds[c + 1]]             # ascending, as the sort is stable
+        local = None                                          # the component's own adjacency
         while len(members):
             anchor = members[0]
             near = members[np.linalg.norm(centroids[members] - centroids[anchor], axis=1) <= eta_dia_m]
             if len(near) == len(members):
                 region = members
             else:
-                sub = adjacency[near][:, near]
-                region = near[np.sort(breadth_first_order(sub, 0, directed=False, return_predecessors=False))]
+                if local is None:
+                    component = members
+                    local = adjacency[component][:, component]
+                pick = np.searchsorted(component, near)
+                bfs = breadth_first_order(local[pick][:, pick], 0, directed=False, return_predecessors=False)
+                region = near[np.sort(bfs)]
             free[region] = False
             regions.append(region)
             members = members[free[members]]
