@@ -16,7 +16,7 @@ import math
 import numpy as np
 from scipy.sparse import csr_matrix
 
-from .navgraph import _NEIGHBOURS_8, NavGraph, Voxels, _Lookup, inclination_among, inclination_reach
+from .navgraph import _NEIGHBOURS_8, NavGraph, Voxels, _Lookup, around, distinct, inclination_among, inclination_reach
 from .occupancy import FREE, OCCUPIED, UNKNOWN, Grid
 
 
@@ -118,17 +118,18 @@ class LeggedGraphUpdater:
             self._setup(grid)
             changed = np.flatnonzero(occ != UNKNOWN)
         changed = np.asarray(changed, dtype=np.int64)
+        sh = self._shape
         rock = self._set(self.rock, changed, occ[changed] == OCCUPIED)
-        ground = self._around(changed, [(0, 0, 0), (0, 0, 1)])
-        q = Voxels(ground, grid.shape)
+        ground = around(changed, sh, [(0, 0, 0), (0, 0, 1)])
+        q = Voxels(ground, sh)
         ground = self._set(self.ground, ground, (occ[ground] == FREE) & (q.at(occ, (0, 0, -1), UNKNOWN) == OCCUPIED))
-        stand = self._distinct(np.concatenate([self._around(changed, [(0, 0, 0), (0, 0, 1)]), self._around(ground, self._disc),
-                                          self._around(rock, [(0, 0, -c) for c in range(1, self.n_up + 1)])]))
+        stand = distinct(sh, np.concatenate([around(changed, sh, [(0, 0, 0), (0, 0, 1)]), around(ground, sh, self._disc),
+                                             around(rock, sh, [(0, 0, -c) for c in range(1, self.n_up + 1)])]))
         stand = self._set(self.standable, stand, self._where_free(occ, stand, self._standable))
-        node = self._distinct(np.concatenate([self._around(stand, [(0, 0, 0)] + [tuple(-a for a in d) for d in self._slope]),
-                                         self._around(rock, [tuple(-a for a in d) for d in self._body])]))
+        node = distinct(sh, np.concatenate([around(stand, sh, [(0, 0, 0)] + _negated(self._slope)),
+                                            around(rock, sh, _negated(self._body))]))
         node = self._set(self.node, node, self._where_free(occ, node, self._nodes, among=self.standable))
-        sources = self._around(node, [(0, 0, 0)] + [tuple(-a for a in d) for d in self._offsets + self._sides])
+        sources = around(node, sh, [(0, 0, 0)] + _negated(self._offsets + self._sides))
         src, dst, w = self._edges
         with _Lookup(len(self.node), sources) as redo:
             keep = redo[src] == 0
@@ -155,27 +156,6 @@ class LeggedGraphUpdater:
         state[flat] = value
         return changed
 
-    def _around(self, flat: np.ndarray, offsets: list[tuple[int, int, int]]) -> np.ndarray:
-        """The distinct voxels (flat, inside the grid) at ``offsets`` from the voxels ``flat``."""
-        v = Voxels(flat, self._shape)
-        ny, nz = self._shape[1], self._shape[2]
-        parts = []
-        for d in offsets:
-            target = v.flat + (d[0] * ny + d[1]) * nz + d[2]
-            near = np.flatnonzero(v.margin < max(abs(d[0]), abs(d[1]), abs(d[2])))
-            if len(near):
-                t = v.ijk[near] + np.array(d)
-                out = ~np.all((t >= 0) & (t < np.array(self._shape)), axis=1)
-                target = np.delete(target, near[out])
-            parts.append(target)
-        return self._distinct(np.concatenate(parts)) if parts else flat
-
-    def _distinct(self, flat: np.ndarray) -> np.ndarray:
-        """The distinct values of ``flat`` (voxels' flat indices), found with the shared
-        voxel -> position lookup (a scatter and a gather: faster than sorting)."""
-        with _Lookup(len(self.node), flat) as at:
-            return flat[at[flat] == np.arange(1, len(flat) + 1)]
-
     def _graph(self, grid: Grid, src: np.ndarray, dst: np.ndarray, w: np.ndarray) -> NavGraph:
         """The nodes in the map's order of free voxels, numbered, and their edges."""
         free = Voxels.free_of(grid)
@@ -186,3 +166,8 @@ class LeggedGraphUpdater:
         with _Lookup(len(self.node), nodes.flat) as ids:
             rows, cols = ids[src].astype(np.int64) - 1, ids[dst].astype(np.int64) - 1
         return NavGraph(positions=positions, adjacency=csr_matrix((w, (rows, cols)), shape=(n, n)))
+
+
+def _negated(offsets: list[tuple[int, int, int]]) -> list[tuple[int, int, int]]:
+    """The voxels that look at a voxel through ``offsets`` lie at the negated offsets."""
+    return [(-a, -b, -c) for a, b, c in offsets]
