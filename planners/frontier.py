@@ -10,6 +10,7 @@ goal is nearest along the navigation graph is chosen. Clusters whose goal failed
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -35,13 +36,16 @@ class FrontierCluster:
 
 @dataclass(frozen=True)
 class FrontierGoal:
-    """The chosen cluster, the graph node to go to, the path length to it and the
-    straight distance from that node to the cluster's centroid."""
+    """The chosen cluster, the graph node to go to, the path length to it, the
+    straight distance from that node to the cluster's centroid, and ``targets``: the
+    cluster's voxels (flat indices) the sensor can observe from that node, on which a
+    visit is judged."""
 
     cluster: FrontierCluster
     node: int
     path_length_m: float
     offset_m: float
+    targets: np.ndarray
 
 
 #: Unknown voxels in a row beyond a free voxel that make it a frontier.
@@ -59,31 +63,35 @@ def frontier_voxels(grid: Grid, among: np.ndarray | None = None, depth: int = FR
     """
     flat_occ = grid.occupancy.reshape(-1)
     free = Voxels.free_of(grid) if among is None else Voxels(among[flat_occ[among] == FREE], grid.shape)
-    is_frontier = np.zeros(len(free), dtype=bool)
-    for d in FACES:
-        solid = free.at(flat_occ, d, FREE) == UNKNOWN
+    return free.flat[_unknown_faces(flat_occ, free, depth).any(axis=1)]
+
+
+def _unknown_faces(flat_occ: np.ndarray, voxels: Voxels, depth: int) -> np.ndarray:
+    """(N, 6) whether the next ``depth`` voxels along each of :data:`FACES` are UNKNOWN."""
+    out = np.zeros((len(voxels), len(FACES)), dtype=bool)
+    for j, d in enumerate(FACES):
+        solid = voxels.at(flat_occ, d, FREE) == UNKNOWN
         for k in range(2, depth + 1):
             idx = np.flatnonzero(solid)
-            solid[idx] = free.at(flat_occ, (d[0] * k, d[1] * k, d[2] * k), FREE, idx) == UNKNOWN
-        is_frontier |= solid
-    return free.flat[is_frontier]
+            solid[idx] = voxels.at(flat_occ, (d[0] * k, d[1] * k, d[2] * k), FREE, idx) == UNKNOWN
+        out[:, j] = solid
+    return out
 
 
 #: Viewpoints tried per frontier voxel for a line of sight, spread from the nearest
 #: to the farthest of those whose elevation the sensor covers (bounds the work).
 SIGHT_TRIES = 6
-#: Viewpoints that may observe a frontier are one node per cell of this size (m) ...
+#: Viewpoints that may observe a frontier, and goal candidates, are one node per cell
+#: of this size (m) ...
 VIEWPOINT_SPACING_M = 1.2
 #: ... and a voxel's nearest this many of them (bounds the memory: they cover 12 m
 #: of a 4 m wide drift either way, or a ball of about 4 m in open 3-D space).
 VIEWPOINTS_PER_VOXEL = 128
 #: A goal node, and a viewpoint that counts, is at most this far from its frontier (m).
 MAX_GOAL_OFFSET_M = 12.0
-#: Goal and viewpoint candidates are thinned to one node per cell of this size (m).
-NODE_SPACING_M = 0.6
 
 
-def viewpoint_nodes(graph: NavGraph, distances: np.ndarray, spacing_m: float = NODE_SPACING_M) -> np.ndarray:
+def viewpoint_nodes(graph: NavGraph, distances: np.ndarray, spacing_m: float = VIEWPOINT_SPACING_M) -> np.ndarray:
     """The nodes reachable from the robot (finite ``distances``), thinned to the first of
     each ``spacing_m`` cell (ascending, deterministic)."""
     reachable = np.flatnonzero(np.isfinite(distances))
@@ -98,10 +106,43 @@ def viewpoint_nodes(graph: NavGraph, distances: np.ndarray, spacing_m: float = N
 
 def in_view(sensor: np.ndarray, points: np.ndarray, view_up_deg: float, slack_m: float) -> np.ndarray:
     """Whether each point is at most ``view_up_deg`` above the horizontal seen from its
-    ``sensor`` (rows pair up), give or take ``slack_m`` of height."""
+    ``sensor`` (rows pair up, or broadcast), give or take ``slack_m`` of height."""
     diff = points - sensor
-    level = np.hypot(diff[:, 0], diff[:, 1])
-    return diff[:, 2] <= level * np.tan(np.radians(min(view_up_deg, 89.9))) + slack_m
+    level = np.hypot(diff[..., 0], diff[..., 1])
+    return diff[..., 2] <= level * np.tan(np.radians(min(view_up_deg, 89.9))) + slack_m
+
+
+#: A LiDAR ray that meets a wall of unknown space at more than this angle from its
+#: normal glances off it: a frontier on the side of a drift is seen from in front.
+MAX_INCIDENCE_DEG = 60.0
+
+
+def view_targets(grid: Grid, voxels: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """What a sensor must see to observe each frontier voxel (flat indices): (N, 3)
+    points and (N, 3) unit normals. Where the unknown run lies above the voxel (the
+    unseen air under a roof, which a LiDAR with a narrow vertical view sees only from
+    afar), the point one voxel higher and no normal (zero); else the voxel's centre and
+    the horizontal face direction it borders unknown space on (zero if only below)."""
+    faces = _unknown_faces(grid.occupancy.reshape(-1), Voxels(voxels, grid.shape), FRONTIER_DEPTH)
+    up, side = faces[:, FACES.index((0, 0, 1))], faces[:, :4]
+    pts = grid.to_world(np.stack(np.unravel_index(voxels, grid.shape), axis=1))
+    pts[up, 2] += grid.voxel_size_m
+    normal = np.where((~up & side.any(axis=1))[:, None], np.array(FACES[:4], float)[np.argmax(side, axis=1)], 0.0)
+    return pts, normal
+
+
+def observes(sensor: np.ndarray, points: np.ndarray, normals: np.ndarray, view_up_deg: float, reach_m: float,
+             slack_m: float) -> np.ndarray:
+    """Whether a sensor at ``sensor`` sees each view target (:func:`view_targets`;
+    rows pair up, or broadcast): within ``reach_m``, at most ``view_up_deg`` above its
+    horizontal (:func:`in_view`, give or take ``slack_m``) and, where the target has a
+    normal, at most :data:`MAX_INCIDENCE_DEG` from it. Lines of sight are not checked."""
+    diff = points - sensor
+    level = np.hypot(diff[..., 0], diff[..., 1])
+    dist = np.hypot(level, diff[..., 2])
+    facing = np.einsum("...i,...i->...", diff, normals) >= np.cos(np.radians(MAX_INCIDENCE_DEG)) * dist * np.abs(
+        normals).sum(axis=-1)
+    return (dist <= reach_m) & facing & (diff[..., 2] <= level * np.tan(np.radians(min(view_up_deg, 89.9))) + slack_m)
 
 
 def clear_sight(grid: Grid, a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -202,27 +243,50 @@ def frontier_clusters(grid: Grid, voxels: np.ndarray, *, cluster_radius_m: float
     return clusters
 
 
+#: Voxels of each cluster whose view is checked from every goal candidate (bounds the work).
+VIEW_SAMPLES = 16
+#: A goal must let the sensor observe at least this share of what the cluster's best
+#: goal candidate lets it observe.
+VIEW_SHARE = 0.8
+#: Goal candidates, cheapest first, whose line of sight to the cluster is checked.
+SIGHT_CANDIDATES = 8
+
+
 def nearest_frontier(
     graph: NavGraph,
     distances: np.ndarray,
     clusters: list[FrontierCluster],
+    grid: Grid,
     *,
     max_goal_offset_m: float,
     view_up_deg: float = 90.0,
     sensor_height_m: float = 0.0,
     offset_weight: float = 2.0,
-    node_spacing_m: float = NODE_SPACING_M,
+    node_spacing_m: float = VIEWPOINT_SPACING_M,
+    min_targets: int = 1,
+    accept: Callable[[FrontierGoal], bool] = lambda goal: True,
 ) -> FrontierGoal | None:
     """The cluster whose goal node is cheapest: path length from the robot
-    (``distances``) plus ``offset_weight`` times the straight distance to the cluster.
+    (``distances``) plus ``offset_weight`` times the straight distance to the cluster's
+    centroid; ``None`` when no cluster has a goal.
 
-    A goal node must lie within ``max_goal_offset_m`` of the cluster's centroid and
-    see it: the centroid may be at most ``view_up_deg`` above the sensor
-    (``sensor_height_m`` above the node), so a ceiling frontier is approached from
-    where a LiDAR with a narrow vertical field of view can see it, not from below. A
-    far goal approaches a frontier the map cannot reach yet; a weight above 1 makes
-    the node nearest the frontier win over the robot's own. Candidate nodes are
-    thinned to one per ``node_spacing_m`` cell. None when no cluster has a goal.
+    A goal node lies within ``max_goal_offset_m`` of the centroid and is chosen for the
+    sensor (``sensor_height_m`` above the node), which sees at most ``view_up_deg``
+    above the horizontal: a frontier voxel is observable from a node when what must be
+    seen of it (:func:`view_targets`: the air above a voxel under an unseen roof) is
+    within that band and ``max_goal_offset_m`` and, for a wall of unknown space, met
+    from in front (:func:`observes`). Of :data:`VIEW_SAMPLES` voxels of each
+    cluster, a goal must observe at least :data:`VIEW_SHARE` of the most that any
+    candidate observes, so the unseen air under a 3 m roof is approached from 8 m along
+    the drift, not from below, where a LiDAR with a 30° view never sees it. A cluster
+    of which no candidate observes ``min_targets`` voxels (estimated from the samples)
+    is no goal for this sensor, from where the robot can walk now. The cheapest
+    candidates (up to :data:`SIGHT_CANDIDATES`) are checked for a line of sight
+    (:func:`clear_sight`) to the voxels they observe; the goal's ``targets`` are those
+    with a clear line. Goals that ``accept`` refuses are passed over with their cluster
+    (the caller's, say a goal where the robot stands already). A far goal approaches a frontier the map cannot reach yet; a
+    weight above 1 makes the node nearest the frontier win over the robot's own.
+    Candidate nodes are thinned to one per ``node_spacing_m`` cell.
     """
     nodes = viewpoint_nodes(graph, distances, node_spacing_m)
     if len(nodes) == 0 or not clusters:
@@ -234,12 +298,55 @@ def nearest_frontier(
         return None
     cand = nodes[np.concatenate([np.asarray(n, dtype=np.int64) for n in near])]
     offset = np.linalg.norm(centroids[owner] - graph.positions[cand], axis=1)
-    sensor = graph.positions[cand] + np.array([0.0, 0.0, sensor_height_m])
-    seen = in_view(sensor, centroids[owner], view_up_deg, 0.5 * node_spacing_m)
-    cost = np.where(seen, distances[cand] + offset_weight * offset, np.inf)
-    k = int(np.argmin(cost))
-    if not np.isfinite(cost[k]):
-        return None
-    node = int(cand[k])
-    return FrontierGoal(cluster=clusters[owner[k]], node=node, path_length_m=float(distances[node]),
-                        offset_m=float(offset[k]))
+    lift = np.array([0.0, 0.0, sensor_height_m])
+    sensor = graph.positions[cand] + lift
+    picks = [c.voxels[np.linspace(0, c.size - 1, min(c.size, VIEW_SAMPLES)).astype(np.int64)] for c in clusters]
+    sizes = np.array([len(p) for p in picks])
+    first = np.cumsum(sizes) - sizes
+    points, normals = view_targets(grid, np.concatenate(picks))
+    pair = np.repeat(np.arange(len(owner)), sizes[owner])
+    sample = first[owner][pair] + np.arange(len(pair)) - np.repeat(np.cumsum(sizes[owner]) - sizes[owner], sizes[owner])
+    seen = observes(sensor[pair], points[sample], normals[sample], view_up_deg, max_goal_offset_m, 0.5 * grid.voxel_size_m)
+    share = np.bincount(pair, weights=seen, minlength=len(owner)) / sizes[owner]
+    best = np.zeros(len(clusters))
+    np.maximum.at(best, owner, share)
+    sizes = np.array([c.size for c in clusters])
+    worth = best * sizes >= min_targets
+    cost = np.where(worth[owner] & (share >= VIEW_SHARE * best[owner]), distances[cand] + offset_weight * offset, np.inf)
+    finite = np.flatnonzero(np.isfinite(cost))
+    by_cluster = finite[np.lexsort((cost[finite], owner[finite]))]
+    rank = np.arange(len(by_cluster)) - np.searchsorted(owner[by_cluster], owner[by_cluster])
+    tries = by_cluster[rank < SIGHT_CANDIDATES]   # each cluster's cheapest candidates ...
+    tries = tries[np.argsort(cost[tries], kind="stable")]   # ... cheapest first
+    tries_left = np.bincount(owner[tries], minlength=len(clusters))
+    cheapest = np.full(len(clusters), -1)
+    for k in tries:
+        c = owner[k]
+        if tries_left[c] == 0:
+            continue
+        cheapest[c] = k if cheapest[c] < 0 else cheapest[c]
+        tries_left[c] -= 1
+        mine = slice(first[c], first[c] + sizes[c])
+        visible = observes(sensor[k], points[mine], normals[mine], view_up_deg, max_goal_offset_m, 0.5 * grid.voxel_size_m)
+        clear = clear_sight(grid, np.broadcast_to(sensor[k], (int(visible.sum()), 3)), points[mine][visible])
+        if clear.sum() >= VIEW_SHARE * share[k] * sizes[c]:
+            targets = _observed(grid, clusters[c].voxels, sensor[k], view_up_deg, max_goal_offset_m)
+        elif tries_left[c] > 0:
+            continue
+        else:  # no clear line from its cheapest candidates: the cheapest, judged on the whole cluster
+            k, targets = cheapest[c], clusters[c].voxels
+        tries_left[c] = 0
+        goal = FrontierGoal(cluster=clusters[c], node=int(cand[k]), path_length_m=float(distances[cand[k]]),
+                            offset_m=float(offset[k]), targets=targets)
+        if accept(goal):
+            return goal
+    return None
+
+
+def _observed(grid: Grid, voxels: np.ndarray, sensor: np.ndarray, view_up_deg: float, reach_m: float) -> np.ndarray:
+    """The ``voxels`` (flat indices) that ``sensor`` observes (:func:`observes`) with a
+    clear line to them (:func:`clear_sight`)."""
+    pts, normals = view_targets(grid, voxels)
+    ok = observes(sensor, pts, normals, view_up_deg, reach_m, 0.5 * grid.voxel_size_m)
+    ok[ok] = clear_sight(grid, np.broadcast_to(sensor, (int(ok.sum()), 3)), pts[ok])
+    return voxels[ok]

@@ -21,9 +21,13 @@ class ExploreFrontiers(Skill):
 
     Frontier voxels (known free next to unknown) of the onboard map are clustered; the
     cluster whose goal node is nearest along the navigation graph is chosen and the
-    robot follows the path to it. The voxels of a cluster that
-    is still a frontier after a visit, or whose path is blocked, are blacklisted: never
-    goals again.
+    robot follows the path to it. Goals are chosen for the robot's LiDAR
+    (:func:`~delve.planners.frontier.nearest_frontier`): from where the frontier lies
+    within its view up (``view_up_deg``), so the unseen air under a roof is looked at
+    from along the drift; a cluster it could see from no node it can reach now is no
+    goal. A visit is judged on the voxels the goal sees (its targets): the voxels of a
+    cluster whose targets are still a frontier after a visit, or whose path is blocked,
+    are blacklisted: never goals again.
 
     Writes: ``frontier_goal`` (x, y, z of the current goal), ``frontiers_left`` (clusters).
     Returns: RUNNING while exploring; SUCCESS when no reachable frontier is left;
@@ -72,8 +76,9 @@ float, 2.0, "how often the target cluster is re-checked", exclusive_minimum=0),
         self.goal = None
 
     def _remaining(self) -> int:
+        """How many of the goal's targets are frontier voxels still."""
         nav = navigator(self.ctx, self.robot)
-        return len(frontier_voxels(nav.grid(), among=self.goal.cluster.voxels))
+        return len(frontier_voxels(nav.grid(), among=self.goal.targets))
 
     def _goal_done(self) -> bool:
         """Whether to plan again: goal reached and scanned, blocked, or explored meanwhile."""
@@ -83,7 +88,7 @@ float, 2.0, "how often the target cluster is re-checked", exclusive_minimum=0),
             if now - self.checked_s < self.p["check_period_s"]:
                 return False
             self.checked_s = now
-            if self._remaining() <= (1 - self.p["explored_fraction"]) * goal.cluster.size:
+            if self._remaining() <= (1 - self.p["explored_fraction"]) * len(goal.targets):
                 self.stop_own_motion()
                 return True
             return False
@@ -92,7 +97,7 @@ float, 2.0, "how often the target cluster is re-checked", exclusive_minimum=0),
                 self.arrived_s = now
             if now - self.arrived_s < self.p["dwell_s"]:
                 return False
-            if self._remaining() > (1 - self.p["explored_fraction"]) * goal.cluster.size:
+            if self._remaining() > (1 - self.p["explored_fraction"]) * len(goal.targets):
                 self._blacklist("still a frontier after a visit")
             return True
         if status == PathStatus.BLOCKED:
@@ -119,7 +124,7 @@ float, 2.0, "how often the target cluster is re-checked", exclusive_minimum=0),
                 return Status.FAILURE
             clusters = self._clusters(grid, plan, candidates)
             self.write("frontiers_left", len(clusters))
-            goal = self._choose(plan, clusters)
+            goal = self._choose(grid, plan, clusters)
             if goal is not None:
                 break
         else:
@@ -135,28 +140,28 @@ float, 2.0, "how often the target cluster is re-checked", exclusive_minimum=0),
         return Status.RUNNING
 
     def _clusters(self, grid: Grid, plan: Plan, candidates: np.ndarray) -> list[FrontierCluster]:
-        """Clusters of the ``candidates`` (frontier voxels). Leaving out the voxels no
-        reachable node's LiDAR could observe (:func:`observable_frontiers`, which
-        map.png uses) made each planning step about 7 times slower and lost coverage
-        on the demo (docs/benchmarks.md, "Frontiers after a visit"), so the explorer
-        does not."""
+        """Clusters of the ``candidates`` (frontier voxels)."""
         return frontier_clusters(grid, candidates, cluster_radius_m=self.p["cluster_radius_m"],
                                  min_cluster_voxels=self.p["min_cluster_voxels"],
                                  max_extent_m=self.p["max_cluster_extent_m"])
 
-    def _choose(self, plan: Plan, clusters: list[FrontierCluster]) -> FrontierGoal | None:
-        """The nearest frontier whose goal is not where the robot already stands."""
-        while True:
-            goal = nearest_frontier(plan.graph, plan.distances, clusters, max_goal_offset_m=self.p["max_goal_offset_m"],
-                                    view_up_deg=self.robot.view_up_deg)
-            if goal is None or goal.node != plan.source:
-                return goal
+    def _choose(self, grid: Grid, plan: Plan, clusters: list[FrontierCluster]) -> FrontierGoal | None:
+        """The nearest frontier whose goal is not where the robot already stands, its
+        goal chosen for the LiDAR's view (:func:`nearest_frontier`)."""
+
+        def elsewhere(goal: FrontierGoal) -> bool:
+            if goal.node != plan.source:
+                return True
             if goal.offset_m <= self.p["observe_radius_m"]:
                 # The robot stands next to the frontier and still sees it: it never will.
                 self.goal = goal
                 self._blacklist("unobservable from its goal")
             # Otherwise the graph does not reach any nearer: skip it on this graph.
-            clusters = [c for c in clusters if c is not goal.cluster]
+            return False
+
+        return nearest_frontier(plan.graph, plan.distances, clusters, grid, max_goal_offset_m=self.p["max_goal_offset_m"],
+                                view_up_deg=self.robot.view_up_deg, min_targets=self.p["min_cluster_voxels"],
+                                accept=elsewhere)
 
 
 __all__ = ["ExploreFrontiers"]

@@ -1,7 +1,7 @@
 import numpy as np
 
-from delve.planners.frontier import (frontier_clusters, frontier_voxels, nearest_frontier,
-                                    observable_frontiers, viewpoint_nodes)
+from delve.planners.frontier import (frontier_clusters, frontier_voxels, nearest_frontier, observable_frontiers,
+                                    observes, view_targets, viewpoint_nodes)
 from delve.planners.navgraph import legged_graph
 from delve.planners.occupancy import FREE, OCCUPIED, UNKNOWN, Grid
 
@@ -36,7 +36,7 @@ def test_clusters_and_nearest_choice():
     g = legged_graph(grid, body_height_m=0.5, radius_m=0.4, max_step_m=0.3, max_inclination_deg=35)
     src = g.nearest(np.array([3.5, 5.5, 0.9]), 1.0)
     dist, _ = g.shortest_paths(src)
-    goal = nearest_frontier(g, dist, clusters, max_goal_offset_m=3.0)
+    goal = nearest_frontier(g, dist, clusters, grid, max_goal_offset_m=3.0)
     assert goal is not None
     # the side branch (y ~ 9 m) is nearer to x=3.5 than the corridor's end at x=8
     assert goal.cluster.centroid[1] > 8.0
@@ -71,3 +71,51 @@ def test_frontiers_that_a_narrow_lidar_sees_from_nowhere_reachable_are_not_front
     _, _, views = viewpoints_of(long)
     seen = observable_frontiers(long, front, views, view_up_deg=15.0, reach_m=12.0)
     assert len(front) > 50 and len(seen) >= 0.9 * len(front)
+
+
+def goal_on(grid: Grid, view_up_deg: float):
+    """The goal for the largest frontier cluster of ``grid``, seen from a robot at x = 1 m."""
+    g, dist, _ = viewpoints_of(grid)
+    clusters = frontier_clusters(grid, frontier_voxels(grid), cluster_radius_m=0.8, min_cluster_voxels=10,
+                                 max_extent_m=4.0)
+    clusters = [max(clusters, key=lambda c: c.size)]
+    return g, nearest_frontier(g, dist, clusters, grid, max_goal_offset_m=12.0, view_up_deg=view_up_deg,
+                               min_targets=10)
+
+
+def test_a_goal_under_an_unseen_roof_stands_back_where_a_narrow_lidar_sees_it():
+    # the top 0.6 m of air over x = 17..20 m of a 20 m drift is unknown; the robot is at x = 1 m
+    grid = drift_with_an_unseen_roof(20.0, 17.0, 20.0, stub=False)
+    g, goal = goal_on(grid, 15.0)
+    node = g.positions[goal.node]
+    points, normals = view_targets(grid, goal.cluster.voxels)
+    up = np.all(normals == 0, axis=1)  # most are below the unknown air: their target is the air, no face to meet
+    assert up.mean() > 0.5 and np.all(points[up, 2] >= 2.5)
+    # from below, the roof air is out of a 15 degree view; the goal sees it from ~7 m back
+    level = np.hypot(*(points[:, :2] - node[:2]).T)
+    assert np.mean(points[:, 2] - node[2] <= level * np.tan(np.radians(15)) + 0.1) >= 0.8
+    assert len(goal.targets) >= 0.8 * goal.cluster.size
+    assert goal.cluster.centroid[0] - node[0] > 6.0  # (the centroid alone is in view from 4.4 m back)
+    # a sensor that sees straight up goes under it
+    g, up = goal_on(grid, 90.0)
+    assert abs(up.cluster.centroid[0] - g.positions[up.node][0]) < 1.5  # (one candidate node per 1.2 m cell)
+
+
+def test_a_frontier_a_narrow_lidar_sees_from_no_node_is_no_goal():
+    # the stub's roof air is more than 15 degrees above the sensor from every node of the short drift
+    grid = drift_with_an_unseen_roof(6.0, 2.6, 3.8, stub=True)
+    assert len(frontier_voxels(grid)) > 50
+    assert goal_on(grid, 15.0)[1] is None
+    assert goal_on(grid, 90.0)[1] is not None
+
+
+def test_a_frontier_in_a_wall_is_observed_from_in_front_not_along_it():
+    grid = t_junction()  # the side branch's unknown end: frontier voxels facing +y at y = 8.9 m
+    side = frontier_voxels(grid)
+    side = side[np.unravel_index(side, grid.shape)[1] == 44]
+    points, normals = view_targets(grid, side)
+    assert np.all(normals == [0.0, 1.0, 0.0])
+    target = points[np.argmin(np.linalg.norm(points - [3.5, 8.9, 1.5], axis=1))]
+    in_front, along = target + [0.0, -4.0, 0.0], target + [-4.0, -0.5, 0.0]
+    seen = observes(np.array([in_front, along]), target[None], normals[:1], 90.0, 12.0, 0.1)
+    assert seen.tolist() == [True, False]

@@ -38,7 +38,11 @@ def test_explore_heads_for_the_frontier_and_writes_the_blackboard(half_mapped):
     assert explore.status == Status.RUNNING
     (path,) = robot.paths
     assert np.allclose(path[-1], bb("frontier_goal"))
-    assert body(a, 18.0)[0] <= path[-1][0] <= body(a, 24.0)[0]  # within reach of the frontier
+    # Back from the frontier (the end of the mapped part, floor to roof), where the
+    # LiDAR, 15 degrees up, sees its top voxels (2.9 m above the floor), not under it;
+    # within the 12 m a goal may lie from its frontier.
+    top, back = a[2] + 2.9 - path[-1][2], a[0] + 23.9 - path[-1][0]
+    assert top <= back * np.tan(np.radians(15)) + 0.1 and 8.0 <= back <= 12.0
     assert bb("frontiers_left") == 1
     (goal,) = events(ctx, "frontier_goal")
     assert goal["at"][0] == pytest.approx(a[0] + 24.0, abs=1.0) and goal["clusters"] == 1
@@ -53,6 +57,7 @@ def test_explore_heads_for_the_frontier_and_writes_the_blackboard(half_mapped):
 def test_the_nearest_frontier_first_then_the_next(middle_mapped):
     grid, a, _ = middle_mapped
     robot = FakeRobot(grid, body(a, 30.0))  # 16 m from one frontier, 4 m from the other
+    robot.view_up_deg = 90.0  # goals beside the frontiers (a 15 degree view stands back 9 m from both)
     ctx = make_ctx(robot)
     explore = build("type: ExploreNearestFrontier", ctx)
     explore.tick_once()
@@ -72,8 +77,8 @@ def test_on_a_map_that_never_changes_every_frontier_is_visited_then_exploration_
     assert {e["reason"] for e in events(ctx, "frontier_blacklisted")} == {"still a frontier after a visit"}
     assert bb("frontiers_left") == 0
     assert events(ctx, "exploration_complete")[0]["blacklisted_voxels"] > 0
-    xs = [p[-1][0] for p in robot.paths]
-    assert min(xs) < a[0] + 20.0 and max(xs) > a[0] + 29.0  # both ends visited
+    goals = sorted(e["at"][0] for e in events(ctx, "frontier_goal"))  # both ends visited
+    assert goals == [pytest.approx(a[0] + 14.0, abs=1.0), pytest.approx(a[0] + 34.0, abs=1.0)]
 
 
 @pytest.mark.parametrize("text", ["type: ExploreNearestFrontier",
@@ -118,6 +123,7 @@ def test_a_frontier_explored_on_the_way_is_left_without_blacklisting(half_mapped
 def test_a_blocked_path_blacklists_its_frontier(middle_mapped):
     grid, a, _ = middle_mapped
     robot = FakeRobot(grid, body(a, 26.0))  # 8 m from one frontier, 12 m from the other
+    robot.view_up_deg = 90.0  # a sensor that sees the top of a frontier from beside it
     robot.block_at, robot.block_radius_m = body(a, 29.0), 1.0  # rock on the way to the nearest
     ctx = make_ctx(robot)
     explore = build("type: ExploreNearestFrontier", ctx)
