@@ -310,8 +310,7 @@ def nearest_frontier(
     share = np.bincount(pair, weights=seen, minlength=len(owner)) / sizes[owner]
     best = np.zeros(len(clusters))
     np.maximum.at(best, owner, share)
-    sizes = np.array([c.size for c in clusters])
-    worth = best * sizes >= min_targets
+    worth = best * np.array([c.size for c in clusters]) >= min_targets
     cost = np.where(worth[owner] & (share >= VIEW_SHARE * best[owner]), distances[cand] + offset_weight * offset, np.inf)
     finite = np.flatnonzero(np.isfinite(cost))
     by_cluster = finite[np.lexsort((cost[finite], owner[finite]))]
