@@ -1,11 +1,13 @@
 """Nearest-frontier exploration, the baseline that GBPlanner2 is compared against.
 
-Frontier voxels are known-free voxels next to unknown ones; those that the robot's
-sensor can observe from no place it can reach are left out (:func:`observable_frontiers`,
-issue 16 item 7: a narrow LiDAR and the roof of a drift). They are clustered, each
-cluster gets the navigation node nearest to it as its goal, and the cluster whose
-goal is nearest along the navigation graph is chosen. Clusters whose goal failed
-(unreachable, or still a frontier after a visit) are blacklisted by the caller.
+Frontier voxels are known-free voxels next to unknown ones. They are clustered, each
+cluster gets as its goal the navigation node nearest to it from which the robot's
+sensor observes it (issue 16 item 7: a LiDAR with a narrow vertical view sees the
+unseen air under a drift's roof only from afar), and the cluster whose goal is nearest
+along the navigation graph is chosen. Clusters whose goal failed (unreachable, or
+still a frontier after a visit) are blacklisted by the caller.
+:func:`observable_frontiers` (which map.png draws) also checks each voxel's line of
+sight from every reachable viewpoint, which is too slow for every planning step.
 """
 
 from __future__ import annotations
@@ -91,7 +93,8 @@ VIEWPOINTS_PER_VOXEL = 128
 MAX_GOAL_OFFSET_M = 12.0
 
 
-def viewpoint_nodes(graph: NavGraph, distances: np.ndarray, spacing_m: float = VIEWPOINT_SPACING_M) -> np.ndarray:
+def viewpoint_nodes(graph: NavGraph, distances: np.ndarray,
+                    spacing_m: float = VIEWPOINT_SPACING_M) -> np.ndarray:
     """The nodes reachable from the robot (finite ``distances``), thinned to the first of
     each ``spacing_m`` cell (ascending, deterministic)."""
     reachable = np.flatnonzero(np.isfinite(distances))
@@ -127,7 +130,8 @@ def view_targets(grid: Grid, voxels: np.ndarray) -> tuple[np.ndarray, np.ndarray
     up, side = faces[:, FACES.index((0, 0, 1))], faces[:, :4]
     pts = grid.to_world(np.stack(np.unravel_index(voxels, grid.shape), axis=1))
     pts[up, 2] += grid.voxel_size_m
-    normal = np.where((~up & side.any(axis=1))[:, None], np.array(FACES[:4], float)[np.argmax(side, axis=1)], 0.0)
+    side_face = np.array(FACES[:4], float)[np.argmax(side, axis=1)]
+    normal = np.where((~up & side.any(axis=1))[:, None], side_face, 0.0)
     return pts, normal
 
 
@@ -140,9 +144,11 @@ def observes(sensor: np.ndarray, points: np.ndarray, normals: np.ndarray, view_u
     diff = points - sensor
     level = np.hypot(diff[..., 0], diff[..., 1])
     dist = np.hypot(level, diff[..., 2])
-    facing = np.einsum("...i,...i->...", diff, normals) >= np.cos(np.radians(MAX_INCIDENCE_DEG)) * dist * np.abs(
-        normals).sum(axis=-1)
-    return (dist <= reach_m) & facing & (diff[..., 2] <= level * np.tan(np.radians(min(view_up_deg, 89.9))) + slack_m)
+    has_normal = np.abs(normals).sum(axis=-1)
+    cos_max = np.cos(np.radians(MAX_INCIDENCE_DEG))
+    facing = np.einsum("...i,...i->...", diff, normals) >= cos_max * dist * has_normal
+    below_top = diff[..., 2] <= level * np.tan(np.radians(min(view_up_deg, 89.9))) + slack_m
+    return (dist <= reach_m) & facing & below_top
 
 
 def clear_sight(grid: Grid, a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -284,8 +290,9 @@ def nearest_frontier(
     candidates (up to :data:`SIGHT_CANDIDATES`) are checked for a line of sight
     (:func:`clear_sight`) to the voxels they observe; the goal's ``targets`` are those
     with a clear line. Goals that ``accept`` refuses are passed over with their cluster
-    (the caller's, say a goal where the robot stands already). A far goal approaches a frontier the map cannot reach yet; a
-    weight above 1 makes the node nearest the frontier win over the robot's own.
+    (the caller's, say a goal where the robot stands already). A far goal approaches a
+    frontier the map cannot reach yet; a weight above 1 makes the node nearest the
+    frontier win over the robot's own.
     Candidate nodes are thinned to one per ``node_spacing_m`` cell.
     """
     nodes = viewpoint_nodes(graph, distances, node_spacing_m)
@@ -300,18 +307,22 @@ def nearest_frontier(
     offset = np.linalg.norm(centroids[owner] - graph.positions[cand], axis=1)
     lift = np.array([0.0, 0.0, sensor_height_m])
     sensor = graph.positions[cand] + lift
-    picks = [c.voxels[np.linspace(0, c.size - 1, min(c.size, VIEW_SAMPLES)).astype(np.int64)] for c in clusters]
+    picks = [c.voxels[np.linspace(0, c.size - 1, min(c.size, VIEW_SAMPLES)).astype(np.int64)]
+             for c in clusters]
     sizes = np.array([len(p) for p in picks])
     first = np.cumsum(sizes) - sizes
     points, normals = view_targets(grid, np.concatenate(picks))
     pair = np.repeat(np.arange(len(owner)), sizes[owner])
-    sample = first[owner][pair] + np.arange(len(pair)) - np.repeat(np.cumsum(sizes[owner]) - sizes[owner], sizes[owner])
-    seen = observes(sensor[pair], points[sample], normals[sample], view_up_deg, max_goal_offset_m, 0.5 * grid.voxel_size_m)
+    start = np.repeat(np.cumsum(sizes[owner]) - sizes[owner], sizes[owner])
+    sample = first[owner][pair] + np.arange(len(pair)) - start   # each pair's cluster's samples
+    slack = 0.5 * grid.voxel_size_m
+    seen = observes(sensor[pair], points[sample], normals[sample], view_up_deg, max_goal_offset_m, slack)
     share = np.bincount(pair, weights=seen, minlength=len(owner)) / sizes[owner]
     best = np.zeros(len(clusters))
     np.maximum.at(best, owner, share)
     worth = best * np.array([c.size for c in clusters]) >= min_targets
-    cost = np.where(worth[owner] & (share >= VIEW_SHARE * best[owner]), distances[cand] + offset_weight * offset, np.inf)
+    usable = worth[owner] & (share >= VIEW_SHARE * best[owner])
+    cost = np.where(usable, distances[cand] + offset_weight * offset, np.inf)
     finite = np.flatnonzero(np.isfinite(cost))
     by_cluster = finite[np.lexsort((cost[finite], owner[finite]))]
     rank = np.arange(len(by_cluster)) - np.searchsorted(owner[by_cluster], owner[by_cluster])
@@ -326,7 +337,7 @@ def nearest_frontier(
         cheapest[c] = k if cheapest[c] < 0 else cheapest[c]
         tries_left[c] -= 1
         mine = slice(first[c], first[c] + sizes[c])
-        visible = observes(sensor[k], points[mine], normals[mine], view_up_deg, max_goal_offset_m, 0.5 * grid.voxel_size_m)
+        visible = observes(sensor[k], points[mine], normals[mine], view_up_deg, max_goal_offset_m, slack)
         clear = clear_sight(grid, np.broadcast_to(sensor[k], (int(visible.sum()), 3)), points[mine][visible])
         if clear.sum() >= VIEW_SHARE * share[k] * sizes[c]:
             targets = _observed(grid, clusters[c].voxels, sensor[k], view_up_deg, max_goal_offset_m)
@@ -342,7 +353,8 @@ def nearest_frontier(
     return None
 
 
-def _observed(grid: Grid, voxels: np.ndarray, sensor: np.ndarray, view_up_deg: float, reach_m: float) -> np.ndarray:
+def _observed(grid: Grid, voxels: np.ndarray, sensor: np.ndarray, view_up_deg: float,
+              reach_m: float) -> np.ndarray:
     """The ``voxels`` (flat indices) that ``sensor`` observes (:func:`observes`) with a
     clear line to them (:func:`clear_sight`)."""
     pts, normals = view_targets(grid, voxels)

@@ -159,9 +159,9 @@ float, 2.0, "how often the target cluster is re-checked", exclusive_minimum=0),
             # Otherwise the graph does not reach any nearer: skip it on this graph.
             return False
 
-        return nearest_frontier(plan.graph, plan.distances, clusters, grid, max_goal_offset_m=self.p["max_goal_offset_m"],
-                                view_up_deg=self.robot.view_up_deg, min_targets=self.p["min_cluster_voxels"],
-                                accept=elsewhere)
+        return nearest_frontier(plan.graph, plan.distances, clusters, grid,
+                                max_goal_offset_m=self.p["max_goal_offset_m"], view_up_deg=self.robot.view_up_deg,
+                                min_targets=self.p["min_cluster_voxels"], accept=elsewhere)
 
 
 __all__ = ["ExploreFrontiers"]

@@ -1,7 +1,7 @@
 import numpy as np
 
-from delve.planners.frontier import (frontier_clusters, frontier_voxels, nearest_frontier, observable_frontiers,
-                                    observes, view_targets, viewpoint_nodes)
+from delve.planners.frontier import (frontier_clusters, frontier_voxels, nearest_frontier,
+                                    observable_frontiers, observes, view_targets, viewpoint_nodes)
 from delve.planners.navgraph import legged_graph
 from delve.planners.occupancy import FREE, OCCUPIED, UNKNOWN, Grid
 
@@ -89,7 +89,7 @@ def test_a_goal_under_an_unseen_roof_stands_back_where_a_narrow_lidar_sees_it():
     g, goal = goal_on(grid, 15.0)
     node = g.positions[goal.node]
     points, normals = view_targets(grid, goal.cluster.voxels)
-    up = np.all(normals == 0, axis=1)  # most are below the unknown air: their target is the air, no face to meet
+    up = np.all(normals == 0, axis=1)  # most lie under the unknown air: their target is that air
     assert up.mean() > 0.5 and np.all(points[up, 2] >= 2.5)
     # from below, the roof air is out of a 15 degree view; the goal sees it from ~7 m back
     level = np.hypot(*(points[:, :2] - node[:2]).T)
