@@ -1,0 +1,91 @@
+"""Incremental maps (issue 17 item 1): time per update of the legged navigation graph
+and of the frontier set, updated from the changed voxels against recomputed over the
+whole map, at every navigation-graph update of a real mission, with a check that the
+two agree.
+
+    .venv/bin/python bench/incremental_maps.py [--scenario scenarios/demo.yaml]
+
+The mission runs as usual (its navigators update their legged graphs from the maps'
+change logs); at each update this benchmark also builds the graph with
+``legged_graph`` and the frontier set with ``frontier_voxels`` and with a
+``FrontierUpdater`` on its own change log, times each, and checks that the results are
+equal. Prints the medians and totals over the mission.
+"""
+from __future__ import annotations
+
+import argparse
+import statistics
+import sys
+import time
+from collections import defaultdict
+from pathlib import Path
+
+import numpy as np
+
+from delve.executive.runner import Mission
+from delve.executive.scenario import load_scenario
+from delve.planners.frontier import frontier_voxels
+from delve.planners.frontier_incremental import FrontierUpdater
+from delve.planners.navgraph import legged_graph
+from delve.skills import navigation
+
+TIMES: dict[str, list[float]] = defaultdict(list)
+MISMATCHES: list[str] = []
+
+
+def timed(key: str, fn, *args, **kwargs):
+    t = time.perf_counter()
+    out = fn(*args, **kwargs)
+    TIMES[key].append(time.perf_counter() - t)
+    return out
+
+
+def instrument() -> None:
+    """Wrap Navigator._legged_graph: time it, and compare with the full recomputations."""
+    incremental = navigation.Navigator._legged_graph
+    frontiers: dict[int, tuple[FrontierUpdater, object]] = {}
+
+    def wrapper(self):
+        m, mob = self.robot.onboard_map, self.robot.mobility
+        graph = timed("legged graph, incremental", incremental, self)
+        grid = self.grid()
+        full = timed("legged graph, whole map", legged_graph, grid, body_height_m=mob.body_height_m,
+                     radius_m=mob.radius_m, max_step_m=mob.max_step_m, max_inclination_deg=mob.max_inclination_deg)
+        if not (np.array_equal(graph.positions, full.positions) and (graph.adjacency != full.adjacency).nnz == 0):
+            MISMATCHES.append(f"legged graph at {self.ctx.clock.now_s:.1f} s")
+        if id(m) not in frontiers:
+            frontiers[id(m)] = (FrontierUpdater(), m.change_log())
+            changed = None
+        else:
+            changed = frontiers[id(m)][1].take()
+        got = timed("frontier set, incremental", frontiers[id(m)][0].update, grid, changed)
+        want = timed("frontier set, whole map", frontier_voxels, grid)
+        if not np.array_equal(got, want):
+            MISMATCHES.append(f"frontier set at {self.ctx.clock.now_s:.1f} s")
+        TIMES["free voxels"].append(len(grid.free))
+        return graph
+
+    navigation.Navigator._legged_graph = wrapper
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--scenario", type=Path, default=Path(__file__).parent.parent / "scenarios" / "demo.yaml")
+    args = ap.parse_args()
+    scenario = load_scenario(args.scenario)
+    instrument()
+    mission = Mission(scenario, world=scenario.build_world())
+    mission.run()
+    print(f"$ {' '.join(sys.argv)}")
+    n = len(TIMES["free voxels"])
+    print(f"scenario {scenario.name}: {n} navigation-graph updates, up to {max(TIMES['free voxels']):,} free voxels\n")
+    print(f"{'per update':<28}{'median ms':>10}{'total s':>9}")
+    for key in ("legged graph, whole map", "legged graph, incremental", "frontier set, whole map",
+                "frontier set, incremental"):
+        print(f"{key:<28}{statistics.median(TIMES[key]) * 1e3:>10.1f}{sum(TIMES[key]):>9.2f}")
+    print(f"\nincremental equal to whole-map results at every update: {'yes' if not MISMATCHES else MISMATCHES}")
+    return 0 if not MISMATCHES else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
