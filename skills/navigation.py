@@ -4,14 +4,18 @@ The :class:`Navigator` keeps the navigation graph of the robot's onboard map and
 shortest-path tree from the robot, and rebuilds them when the map has changed and
 they are older than ``rebuild_period_s`` (10 s) of sim time, so that several skills ticking
 in one agent do not plan twice. A legged robot's graph is updated from the voxels that
-changed since the last build (the map's change log), not rebuilt over the whole map.
+changed since the last build (the map's change log), not rebuilt over the whole map, and
+so is the map's set of frontier voxels (:meth:`Navigator.frontier_voxels`).
 """
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
+from ..planners.frontier_incremental import FrontierUpdater
 from ..planners.navgraph import NavGraph, aerial_graph
 from ..planners.navgraph_incremental import LeggedGraphUpdater
 from ..planners.occupancy import Grid
@@ -46,7 +50,8 @@ class Navigator:
         self._plan: Plan | None = None
         self._plan_key: tuple[int, int] | None = None
         self.builds = 0
-        self._legged: tuple[object, ChangeLog, LeggedGraphUpdater] | None = None
+        #: Incremental results by name: (the map, its change log, the updater).
+        self._updaters: dict[str, tuple[object, ChangeLog, Any]] = {}
 
     def grid(self) -> Grid:
         m = self.robot.onboard_map
@@ -73,13 +78,26 @@ class Navigator:
     def _legged_graph(self) -> NavGraph:
         """The legged graph of the current map, updated from the voxels changed since the
         last build (built over the whole map the first time, or for a new map object)."""
-        m, mob = self.robot.onboard_map, self.robot.mobility
-        if self._legged is None or self._legged[0] is not m:
-            updater = LeggedGraphUpdater(body_height_m=mob.body_height_m, radius_m=mob.radius_m,
-                                         max_step_m=mob.max_step_m, max_inclination_deg=mob.max_inclination_deg)
-            self._legged = (m, m.change_log(), updater)
-            return updater.update(self.grid())
-        return self._legged[2].update(self.grid(), self._legged[1].take())
+        mob = self.robot.mobility
+        return self._updated("legged graph", lambda: LeggedGraphUpdater(
+            body_height_m=mob.body_height_m, radius_m=mob.radius_m, max_step_m=mob.max_step_m,
+            max_inclination_deg=mob.max_inclination_deg))
+
+    def frontier_voxels(self) -> np.ndarray:
+        """The frontier voxels of the current map (:func:`delve.planners.frontier.frontier_voxels`
+        of :meth:`grid`, in its order), updated from the voxels changed since the last call."""
+        return self._updated("frontier voxels", FrontierUpdater)
+
+    def _updated(self, name: str, make: Callable[[], Any]) -> Any:
+        """``update`` of the incremental result ``name`` of the current map: from the voxels
+        in the map's change log since the last call, or, the first time or for a new map
+        object, from the whole map (with ``make()`` a new updater)."""
+        m = self.robot.onboard_map
+        kept = self._updaters.get(name)
+        if kept is None or kept[0] is not m:
+            kept = self._updaters[name] = (m, m.change_log(), make())
+            return kept[2].update(self.grid())
+        return kept[2].update(self.grid(), kept[1].take())
 
     def map_changed(self) -> bool:
         """Whether the map has changed since the graph was built (a forced rebuild would differ)."""

@@ -154,3 +154,15 @@ def test_aerial_robots_plan_in_the_whole_free_volume(tunnel):
     fly = navigator(aerial_ctx, aerial).graph().positions
     assert np.ptp(walk[:, 2]) == pytest.approx(0.0)  # one body height over the flat floor
     assert np.ptp(fly[:, 2]) > 1.0                     # every height between floor and roof
+
+
+def test_the_frontier_voxels_follow_the_map_changes(tunnel):
+    from delve.planners.frontier import frontier_voxels
+
+    robot, ctx = robot_at(tunnel, 3.0)
+    nav = navigator(ctx, robot)
+    before = nav.frontier_voxels()
+    assert np.array_equal(before, frontier_voxels(nav.grid()))
+    robot.onboard_map.write(wall_at(tunnel, 15.0) | wall_at(tunnel, 15.4), UNKNOWN)  # 0.8 m of the tunnel forgotten
+    after = nav.frontier_voxels()
+    assert np.array_equal(after, frontier_voxels(nav.grid())) and len(after) > len(before)
