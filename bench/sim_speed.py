@@ -21,6 +21,8 @@ from delve.executive import agent as agent_mod
 from delve.executive.runner import Mission
 from delve.executive.scenario import load_scenario
 from delve.planners import frontier, navgraph
+from delve.planners.frontier_incremental import FrontierUpdater
+from delve.planners.navgraph_incremental import LeggedGraphUpdater
 from delve.sim import robot as robot_mod
 from delve.sim.voxel_map import VoxelMap
 from delve.sim.world import World
@@ -47,8 +49,10 @@ def instrument() -> None:
     timed(World, "cast_rays", "ray casting")
     timed(VoxelMap, "integrate_scan", "map integration")
     for mod in (navigation, navgraph):
-        timed(mod, "legged_graph", "planning")
         timed(mod, "aerial_graph", "planning")
+    timed(navgraph, "legged_graph", "planning")
+    timed(LeggedGraphUpdater, "update", "planning")
+    timed(FrontierUpdater, "update", "planning")
     timed(navgraph.NavGraph, "shortest_paths", "planning")
     for mod in (exploration, frontier):
         timed(mod, "frontier_voxels", "planning")
