@@ -9,6 +9,7 @@ from __future__ import annotations
 from .base import TeamStrategy
 from .cohort import Cohort
 from .cops import Cops
+from .csiro import Csiro
 from .independent import Independent
 
 #: The registered strategies by the name a scenario gives.
@@ -36,6 +37,7 @@ def wall_clock_fields() -> tuple[str, ...]:
 register_team("independent", Independent)
 register_team("cops", Cops)
 register_team("cohort", Cohort)
+register_team("csiro", Csiro)
 
 __all__ = ["DEFAULT_STRATEGY", "TEAM_STRATEGIES", "TeamStrategy", "implied_strategy", "register_team",
            "wall_clock_fields"]

@@ -1,0 +1,136 @@
+"""Going to the selected frontier, with the failure rule of Algorithm 3 (no 1 m of progress in
+15 s) and, for a distant frontier, the topometric map's A* path first (Section IV-C)."""
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from py_trees.common import Status
+from py_trees.ports import PortInformation
+
+from ...planners.csiro.selection import GoalProgress, uav_frontier_complete
+from ...planners.csiro.topometric import frontier_node
+from ...planners.geometry import xyz
+from ..base import Param
+from ..motion import GoTo
+from .state import CsiroState, csiro_state
+
+
+class FollowFrontierGoal(GoTo):
+    """Go to the selected frontier's ``goal`` (written by a Select behaviour) and stay until the
+    frontier changes.
+
+    A ground robot's first path is the topometric map's A* path to the frontier (other robots'
+    trajectories cross space its own map lacks), re-planned like ``GoTo`` when blocked. Progress
+    is watched as Algorithm 3 says: when the closest approach to the goal improves by less than
+    ``progress_m`` in ``progress_window_s`` (1 m, 15 s), or the way cannot be planned, or the
+    frontier is still unchanged ``dwell_s`` after the robot reached the goal, the goal has
+    failed: a ground robot's frontier gets the penalty rho_fail until it is updated and its
+    observer joins the failed goals of L; a flying robot blacklists it.
+
+    Reads ``goal`` and ``csiro_goal``. Returns SUCCESS when the frontier is gone (explored), its
+    observer moved more than ``reselect_m`` from the goal (select again), or (flying robot) it
+    came within eta_blacklist of its centre (complete, and blacklisted); RUNNING on the way and
+    while standing at the goal; FAILURE when the goal failed (``csiro_goal_failed`` in the log).
+    """
+
+    PARAMS = {**{k: v for k, v in GoTo.PARAMS.items() if k != "goal"},
+              "reselect_m": Param(float, 2.0, "select again when the frontier's observer moved this far",
+                                  exclusive_minimum=0),
+              "dwell_s": Param(float, 5.0, "at the goal this long with the frontier unchanged: the goal has failed",
+                               minimum=0)}
+    INPUT_PORTS = {**GoTo.INPUT_PORTS,
+                   "csiro_goal": PortInformation(list, required=False, description="[owner, id] the frontier")}
+
+    def __init__(self, name: str, ctx: Any, remap: dict[str, str] | None = None, **params: Any):
+        super().__init__(name, ctx, remap, goal=None, **params)
+        self.key: tuple[str, int] | None = None
+        self.watch: GoalProgress | None = None
+        self.watch_key: tuple[str, int] | None = None
+        self.arrived_s: float | None = None
+
+    def initialise(self) -> None:
+        super().initialise()
+        self.arrived_s = None
+        key = self.read("csiro_goal")
+        self.key = None if key is None else (str(key[0]), int(key[1]))
+        st = csiro_state(self.ctx)
+        if self.watch is None or self.watch_key != self.key:  # the same frontier again: same watch
+            self.watch = GoalProgress(np.zeros(3), st.selection)
+            self.watch_key = self.key
+
+    def update(self) -> Status:
+        if self.key is None:
+            self.feedback_message = "no frontier selected"
+            return Status.FAILURE
+        st, r = csiro_state(self.ctx), self.robot
+        if self.goal is None:
+            self.goal = self._read_goal()
+            if self.goal is not None:
+                self.watch.goal = self.goal
+        done = self._frontier_done(st)
+        if done:
+            self.stop_own_motion()
+            self.moving = False
+            self.event("csiro_goal_done", key=list(self.key), why=done)
+            return Status.SUCCESS
+        if self.watch.update(self.ctx.clock.now_s, r.position):
+            return self._failed(st, f"closest approach improved less than {self.watch.progress_m:g} m in "
+                                    f"{self.watch.window_s:g} s")
+        if self.goal is not None and self.reached():
+            self.stop_own_motion()
+            self.moving = False
+            now = self.ctx.clock.now_s
+            self.arrived_s = now if self.arrived_s is None else self.arrived_s
+            if now - self.arrived_s >= self.p["dwell_s"]:
+                return self._failed(st, f"still a frontier {self.p['dwell_s']:g} s after reaching its observer")
+            self.feedback_message = "at the goal, waiting for the frontier to change"
+            return Status.RUNNING
+        self.arrived_s = None
+        status = super().update()
+        if status == Status.FAILURE:
+            return self._failed(st, self.feedback_message)
+        return Status.RUNNING if status == Status.SUCCESS else status
+
+    def _frontier_done(self, st: CsiroState) -> str:
+        """Why the goal is over ('' while it is not)."""
+        key, r = self.key, self.robot
+        if r.mobility.aerial:
+            frontier = next((f for f in st.frontiers.frontiers if f.id == key[1]), None)
+            if frontier is None:
+                return "explored"
+            if uav_frontier_complete(frontier, r.position, st.selection):
+                st.blacklist.add(key[1])
+                return "complete"
+            return ""
+        summary = st.summaries.get(key)
+        if summary is None:
+            return "explored"
+        if self.goal is not None and np.linalg.norm(summary.observer[:2] - self.goal[:2]) > self.p["reselect_m"]:
+            return "observer moved"
+        return ""
+
+    def _failed(self, st: CsiroState, why: str) -> Status:
+        self.stop_own_motion()
+        self.moving = False
+        key = self.key
+        if self.robot.mobility.aerial:
+            st.blacklist.add(key[1])
+        elif key in st.summaries:
+            st.failed.mark(st.summaries[key])
+        self.watch = None
+        st.goal = None
+        self.feedback_message = why
+        self.event("csiro_goal_failed", key=list(key), reason=why, position=xyz(self.robot.position, 2))
+        return Status.FAILURE
+
+    def _path(self, grid: Any) -> tuple[np.ndarray | None, str, str, str]:
+        st, r = csiro_state(self.ctx), self.robot
+        if self.replans == 0 and not r.mobility.aerial:
+            path = st.topometric.path(r.position, frontier_node(self.key))
+            if path is not None and len(path.points) > 2:
+                return path.points[1:-1], "topometric", "", ""   # the goal is appended by GoTo
+        return super()._path(grid)
+
+
+__all__ = ["FollowFrontierGoal"]

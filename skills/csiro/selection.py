@@ -1,0 +1,116 @@
+"""Frontier selection (Section IV): the ground robot's reward per unit distance over every
+frontier the team shared (equation 15, Algorithm 3), the flying robot's own frontiers by
+equation 16."""
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from py_trees.common import Status
+from py_trees.ports import PortInformation
+
+from ...planners.csiro.selection import select_uav_frontier, select_ugv_frontier
+from ...planners.csiro.topometric import frontier_node
+from ...planners.geometry import xyz
+from ..base import Param, Skill
+from ..navigation import navigator
+from .frontiers import body_lift
+from .state import csiro_state
+
+_OUTPUTS = {
+    "goal": PortInformation(list | None, description="[x, y, z] where to go: the frontier's observer (ground "
+                            "robot, body height added) or the reachable place nearest its centre (flying robot)"),
+    "csiro_goal": PortInformation(list | None, description="[owner, id] the frontier selected; null: none"),
+}
+
+
+class _Select(Skill):
+    """Shared: wait up to ``wait_s`` for a frontier to select, then fail."""
+
+    ABSTRACT = True
+    PARAMS = {"wait_s": Param(float, 10.0, "sim time to wait for a frontier to select before exploration counts "
+                              "as done", minimum=0)}
+    OUTPUT_PORTS = _OUTPUTS
+
+    def initialise(self) -> None:
+        self.since_s = self.ctx.clock.now_s
+
+    def none_left(self) -> Status:
+        """RUNNING while waiting for a frontier, then FAILURE (logs ``csiro_no_frontier``)."""
+        csiro_state(self.ctx).goal = None
+        self.write("csiro_goal", None)
+        if self.ctx.clock.now_s - self.since_s < self.p["wait_s"]:
+            self.feedback_message = "waiting for a frontier"
+            return Status.RUNNING
+        self.feedback_message = "no frontier left"
+        self.event("csiro_no_frontier", position=xyz(self.robot.position, 2))
+        return Status.FAILURE
+
+    def chosen(self, key: tuple[str, int], goal: np.ndarray, **why: Any) -> Status:
+        st = csiro_state(self.ctx)
+        st.goal = key
+        self.write("csiro_goal", [key[0], key[1]])
+        self.write("goal", xyz(goal, 3))
+        self.feedback_message = f"frontier {key[0]}/{key[1]}"
+        self.event("csiro_goal_selected", key=[key[0], key[1]], goal=xyz(goal, 2), **why)
+        return Status.SUCCESS
+
+
+class SelectUgvFrontier(_Select):
+    """Algorithm 3 for a ground robot: of every frontier summary it knows (its own and the
+    team's), the one of highest discounted reward per unit of topometric distance to its
+    observer (equations 14-15), skipping those other robots hold and penalising failed ones.
+
+    Writes ``goal`` (the observer, body height added) and ``csiro_goal``. Returns SUCCESS with a
+    goal; RUNNING while none is selectable, up to ``wait_s``; then FAILURE (exploration over).
+    """
+
+    def update(self) -> Status:
+        r, name = self.robot, self.ctx.name
+        st = csiro_state(self.ctx, r.view_up_deg)
+        keys = sorted(st.summaries)
+        summaries = [st.summaries[k] for k in keys]
+        distances = st.topometric.distances(r.position, [frontier_node(k) for k in keys])
+        held = [g[0] for other, g in sorted(st.goals.items()) if other != name]
+        choice = select_ugv_frontier(summaries, distances, st.places_set(name), st.selection,
+                                     held_by_others=held, failed=st.failed) if keys else None
+        if choice is None:
+            return self.none_left()
+        goal = st.summaries[choice.key].observer + body_lift(r)
+        return self.chosen(choice.key, goal, utility=round(choice.utility, 3), reward=round(choice.reward, 2),
+                           distance_m=round(choice.distance_m, 1))
+
+
+class SelectUavFrontier(_Select):
+    """Equation 16 for a flying robot, over its own frontiers: size, z-weighted distance and
+    momentum, none smaller than the size limit, blacklisted or complete. Its goal is the place
+    of the navigation graph it can reach that lies nearest the frontier's centre.
+
+    Writes ``goal`` and ``csiro_goal``. Returns SUCCESS with a goal; RUNNING while none is
+    selectable, up to ``wait_s``; then FAILURE (exploration over).
+    """
+
+    def update(self) -> Status:
+        r, name = self.robot, self.ctx.name
+        st = csiro_state(self.ctx, r.view_up_deg)
+        picked = select_uav_frontier(st.frontiers.frontiers, r.position, st.momentum, st.selection,
+                                     blacklist=sorted(st.blacklist))
+        if picked is None:
+            return self.none_left()
+        frontier, st.momentum = picked
+        return self.chosen((name, frontier.id), self._reachable_near(frontier.mean),
+                           area_m2=round(frontier.area, 2))
+
+    def _reachable_near(self, point: np.ndarray) -> np.ndarray:
+        """The reachable navigation node nearest ``point`` (``point`` itself when none)."""
+        plan = navigator(self.ctx, self.robot).from_robot()
+        if plan is None:
+            return np.asarray(point, float)
+        reach = np.flatnonzero(np.isfinite(plan.distances))
+        if not len(reach):
+            return np.asarray(point, float)
+        positions = plan.graph.positions[reach]
+        return positions[int(np.argmin(np.linalg.norm(positions - point, axis=1)))].copy()
+
+
+__all__ = ["SelectUavFrontier", "SelectUgvFrontier"]

@@ -1,0 +1,30 @@
+"""What the CSIRO skill tests share: a 40 m tunnel (its voxel map for the fake robot and its
+surface as LiDAR points) and a fake LiDAR sweep from where the robot stands."""
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+from delve.planners.gbplanner2 import synthetic as syn
+
+from ...planners.csiro.frontier_clouds import corridor
+
+
+@pytest.fixture(scope="session")
+def tunnel():
+    """(grid, a, b): the tunnel's voxel map, mapped all along, floor z = 1 m from a to b along x
+    at y = 6 (4 m wide, 3 m high)."""
+    return syn.straight_tunnel(length_m=40)
+
+
+@pytest.fixture(scope="session")
+def tunnel_points():
+    """The tunnel's surface (floor, roof, walls) as points 0.1 m apart, open at both ends."""
+    return corridor(5.0, 47.0) + np.array([0.0, 6.0, 1.0])
+
+
+def sweep(robot, points: np.ndarray, range_m: float = 30.0) -> None:
+    """Give ``robot`` one LiDAR sweep: the ``points`` within ``range_m`` of it, seen from it."""
+    near = points[np.linalg.norm(points - robot.position, axis=1) <= range_m]
+    robot.lidar_scans.append(SimpleNamespace(sensor=robot.position, points=near))

@@ -1,0 +1,97 @@
+"""delve.skills.csiro.selection: the ground robot's choice by reward per unit of topometric
+distance (equation 15, Algorithm 3) and the flying robot's by equation 16."""
+from __future__ import annotations
+
+import numpy as np
+from delve.planners.csiro.sharing import FrontierSummary
+from delve.skills.csiro import SelectUavFrontier, SelectUgvFrontier, UpdateFrontiers, csiro_state
+from py_trees.common import Status
+
+from ..fakes import FakeRobot, bb, body, events, make_ctx, run
+from .conftest import sweep
+
+
+def summary(owner: str, fid: int, x: float, reward: float = 10.0) -> FrontierSummary:
+    return FrontierSummary(id=fid, owner=owner, mean=np.array([x + 2.0, 6.0, 2.0]), cov=np.eye(3), reward=reward,
+                           observer=np.array([x, 6.0, 1.0]), updated_s=0.0)
+
+
+def ground_robot(tunnel, frontiers_at=(12.0, 40.0)):
+    """A robot at x = 10 that walked the tunnel from x = 7 to 45 (its topometric map) and knows
+    a frontier of equal reward observed from each x of ``frontiers_at``."""
+    grid, a, _ = tunnel
+    robot = FakeRobot(grid, body(a, 3.0))
+    ctx = make_ctx(robot)
+    st = csiro_state(ctx)
+    for x in np.arange(7.0, 46.0, 1.0):
+        st.topometric.add_pose("r1", x, [x, 6.0, 1.5])
+    for k, x in enumerate(frontiers_at):
+        s = st.summaries[("r1", k)] = summary("r1", k, x)
+        st.topometric.attach_frontier(s.key, "r1", x, s.observer + [0, 0, 0.5])
+    return robot, ctx, st
+
+
+def test_ugv_takes_the_highest_reward_per_unit_distance(tunnel):
+    robot, ctx, st = ground_robot(tunnel)
+    node = SelectUgvFrontier("select", ctx)
+    node.tick_once()
+    assert node.status == Status.SUCCESS
+    assert bb("csiro_goal") == ["r1", 0] and st.goal == ("r1", 0)
+    assert np.allclose(bb("goal"), [12.0, 6.0, 1.5])                    # the observer, body height added
+    assert events(ctx, "csiro_goal_selected")[0]["distance_m"] == 4.0         # 10 -> node 13 -> 12
+
+
+def test_ugv_skips_a_frontier_another_robot_holds_and_discounts_visited_places(tunnel):
+    robot, ctx, st = ground_robot(tunnel)
+    st.goals["r2"] = (("r1", 0), np.array([12.0, 6.0, 1.0]))
+    node = SelectUgvFrontier("select", ctx)
+    node.tick_once()
+    assert bb("csiro_goal") == ["r1", 1]
+    st.goals.clear()
+    node.tick_once()
+    assert bb("csiro_goal") == ["r1", 0]
+    # r2 has passed the near frontier's observer three times: equation 14 gives it rho^3 of its
+    # reward, 0.08 / 4 m against 10 / 31 m for the far one
+    st.places["r2"] = np.array([[12.0, 6.0, 1.0]] * 3)
+    node.tick_once()
+    assert bb("csiro_goal") == ["r1", 1]
+
+
+def test_ugv_penalises_a_failed_frontier(tunnel):
+    robot, ctx, st = ground_robot(tunnel, frontiers_at=(12.0, 20.0))
+    node = SelectUgvFrontier("select", ctx)
+    node.tick_once()
+    assert bb("csiro_goal") == ["r1", 0]
+    st.failed.mark(st.summaries[("r1", 0)])
+    node.tick_once()
+    assert bb("csiro_goal") == ["r1", 1]
+
+
+def test_no_frontier_waits_then_ends_exploration(tunnel):
+    grid, a, _ = tunnel
+    robot = FakeRobot(grid, body(a, 3.0))
+    ctx = make_ctx(robot)
+    node = SelectUgvFrontier("select", ctx, wait_s=5.0)
+    assert run(node, ctx, robot, ticks=3) == Status.RUNNING
+    assert run(node, ctx, robot, ticks=10) == Status.FAILURE
+    assert len(events(ctx, "csiro_no_frontier")) == 1 and bb("csiro_goal") is None
+
+
+def test_uav_flies_for_its_own_frontier_and_skips_blacklisted_ones(tunnel, tunnel_points):
+    grid, a, _ = tunnel
+    robot = FakeRobot(grid, a + np.array([18.0, 0.0, 1.5]), platform="aerial")
+    ctx = make_ctx(robot)
+    sweep(robot, tunnel_points)
+    UpdateFrontiers("update", ctx).tick_once()
+    st = csiro_state(ctx)
+    node = SelectUavFrontier("select", ctx)
+    node.tick_once()
+    assert node.status == Status.SUCCESS
+    first = bb("csiro_goal")
+    assert first[0] == "r1" and st.momentum is not None and st.momentum.frontier_id == first[1]
+    frontier = next(f for f in st.frontiers.frontiers if f.id == first[1])
+    goal = np.asarray(bb("goal"))
+    assert np.linalg.norm(goal - frontier.mean) < np.linalg.norm(robot.position - frontier.mean)
+    st.blacklist.add(first[1])
+    node.tick_once()
+    assert node.status == Status.SUCCESS and bb("csiro_goal") != first
