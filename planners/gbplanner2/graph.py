@@ -35,10 +35,9 @@ from scipy.sparse import coo_matrix, csr_matrix
 from scipy.sparse.csgraph import breadth_first_order, dijkstra
 from scipy.spatial import cKDTree
 
-from ..occupancy import FREE
 from .bounds import LocalBound
 from .config import GBPlannerConfig
-from .local_map import GROUND_ATTACHED, GROUND_NONE, LocalMap
+from .local_map import GROUND_BLOCKED, GROUND_NONE, LocalMap
 
 
 @dataclass
@@ -125,10 +124,9 @@ def project_vertices(local_map: LocalMap, points: np.ndarray, config: GBPlannerC
     pts = np.atleast_2d(np.asarray(points, float))
     if len(pts) == 0:
         return pts.copy(), np.zeros(0, bool), np.zeros(0, bool)
-    free = local_map.value(pts) == FREE
     gz, status = local_map.project_to_ground(pts)
     out = pts.copy()
-    usable = free & ((status == GROUND_ATTACHED) | (status == GROUND_NONE))
+    usable = status != GROUND_BLOCKED  # blocked: the sample is not in free space
     out[:, 2] = np.where(usable, gz + config.body_height_m, pts[:, 2])
     hanging = status == GROUND_NONE
     usable &= local_map.is_box_free(out)
