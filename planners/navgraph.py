@@ -167,9 +167,9 @@ def around(flat: np.ndarray, shape: tuple[int, int, int], offsets: list[tuple[in
 
 
 def distinct(shape: tuple[int, int, int], flat: np.ndarray) -> np.ndarray:
-    """The distinct values of ``flat`` (flat indices of a grid of ``shape``), in the order
-    of their last occurrence: a scatter and a gather on the shared lookup, several times
-    faster than ``np.unique``'s sorting or hashing on tens of thousands of indices."""
+    """The distinct values of ``flat`` (flat indices of a grid of ``shape``), each once,
+    unsorted: a scatter and a gather on the shared lookup, several times faster than
+    ``np.unique``'s sorting or hashing on tens of thousands of indices."""
     with _Lookup(int(np.prod(shape)), flat) as at:
         return flat[at[flat] == np.arange(1, len(flat) + 1)]
 
