@@ -176,6 +176,8 @@ class SequentialFrontiers:
         if kept:
             self._scenes[len(self._viewpoints)] = scene
             self._viewpoints.append(Viewpoint(float(t_s), mesh))
+        for k in [k for k in self._scenes if np.linalg.norm(self._viewpoints[k].position - a) > 2 * p.d_max_m]:
+            del self._scenes[k]          # out of reach: the memory back; rebuilt if the agent returns
         return FrontierUpdate(self.frontiers, mesh, None, created, removed, kept)
 
     def _scene(self, k: int) -> o3d.t.geometry.RaycastingScene:
