@@ -14,6 +14,12 @@ i7) and 279 ms (500 vertices, RMF-Obelix, ARM).
 
 Run: ``.venv/bin/python bench/gbplanner.py [--iterations N] [--seed S] [--world synthetic|sim]``
 (``--world sim`` uses ``delve.sim.worldgen.tunnel_network`` when it exists; it is not required.)
+
+``--baseline DIR`` (a delve source tree, e.g. ``git worktree add /tmp/gb_base <commit>``)
+also times that tree's local planner against this one, interleaved on the same inputs
+(ANYmal C, 1000 vertices, ``--runs`` rounds of the iterations), and prints the medians
+and the median ratio of the pairs (pairs share the machine's load) and whether both
+planned the same paths and gains.
 """
 from __future__ import annotations
 
@@ -23,8 +29,10 @@ for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUME
     os.environ.setdefault(_var, "1")
 
 import argparse
+import importlib
 import shlex
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -109,6 +117,54 @@ def run(config: GBPlannerConfig, world: Grid, tunnels: list[Tunnel], iterations:
     return {k: np.asarray(v) for k, v in rows.items()}
 
 
+def baseline_package(tree: Path):
+    """The ``planners`` package of another delve source tree, imported as
+    ``delve_baseline.planners`` (planners import nothing else of delve)."""
+    root = Path(tempfile.mkdtemp(prefix="delve_baseline_"))
+    (root / "delve_baseline").mkdir()
+    (root / "delve_baseline" / "__init__.py").write_text("")
+    (root / "delve_baseline" / "planners").symlink_to(tree.resolve() / "planners")
+    sys.path.insert(0, str(root))
+    return importlib.import_module("delve_baseline.planners")
+
+
+def paired(baseline_tree: Path, world: Grid, tunnels: list[Tunnel], iterations: int, runs: int, seed: int,
+           mapped_radius_m: float) -> list[str]:
+    """Wall and CPU time of one iteration of the baseline tree's local planner and of
+    this one (ANYmal C, 1000 vertices), interleaved, and whether they planned the same."""
+    old = baseline_package(baseline_tree)
+    importlib.import_module("delve_baseline.planners.gbplanner2")
+    old_planner = old.gbplanner2.LocalPlanner(old.gbplanner2.GBPlannerConfig.anymal_c())
+    new_planner = LocalPlanner(GBPlannerConfig.anymal_c())
+    positions = robot_positions(tunnels, iterations + 1, np.random.default_rng(seed), 0.5)
+    times: dict[str, list[tuple[float, float]]] = {"old": [], "new": []}
+    same = True
+    for rep in range(runs):
+        for i, p in enumerate(positions):
+            grid = explored_view(world, p, mapped_radius_m)
+            grids = {"new": grid, "old": old.occupancy.Grid(grid.occupancy, grid.origin, grid.voxel_size_m)}
+            plans = {"new": new_planner, "old": old_planner}
+            out = {}
+            for who in (("old", "new") if (rep + i) % 2 == 0 else ("new", "old")):
+                t, c = time.perf_counter(), time.process_time()
+                out[who] = plans[who].plan(grids[who], p, np.random.default_rng(seed * 1000 + i), yaw_rad=0.0)
+                if i > 0:  # the first position is a warm-up
+                    times[who].append((time.perf_counter() - t, time.process_time() - c))
+            same &= out["old"].gain == out["new"].gain and (
+                (out["old"].path is None and out["new"].path is None)
+                or np.array_equal(out["old"].path, out["new"].path))
+    o, n = np.array(times["old"]), np.array(times["new"])
+    return [
+        f"baseline {baseline_tree}: ANYmal C, 1000 vertices, {len(o)} pairs (interleaved), median",
+        f"{'':<10}{'wall ms':>9}{'cpu ms':>9}",
+        f"{'baseline':<10}{np.median(o[:, 0]) * 1e3:>9.1f}{np.median(o[:, 1]) * 1e3:>9.1f}",
+        f"{'this tree':<10}{np.median(n[:, 0]) * 1e3:>9.1f}{np.median(n[:, 1]) * 1e3:>9.1f}",
+        f"{'ratio':<10}{np.median(n[:, 0] / o[:, 0]):>9.3f}{np.median(n[:, 1] / o[:, 1]):>9.3f}"
+        "   (median of the pairs' ratios, this tree / baseline)",
+        f"same paths and gains: {'yes' if same else 'NO'}",
+    ]
+
+
 def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--iterations", type=int, default=12, help="timed iterations per row (>= 10)")
@@ -116,6 +172,9 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--mapped-radius", type=float, default=40.0, help="m of tunnel mapped around the robot")
     ap.add_argument("--world", choices=("synthetic", "sim"), default="synthetic",
                     help="synthetic: this script's tunnel grid; sim: delve.sim.worldgen.tunnel_network (optional)")
+    ap.add_argument("--baseline", type=Path, metavar="DIR",
+                    help="a delve source tree whose local planner to time against this one (see the docstring)")
+    ap.add_argument("--runs", type=int, default=3, help="rounds of the iterations with --baseline")
     args = ap.parse_args(argv)
     if args.iterations < 1:
         ap.error("--iterations must be >= 1")
@@ -158,6 +217,9 @@ def main(argv: list[str] | None = None) -> None:
         print(f"{name:<20} {vs:>5.1f} {cfg.num_vertices_max:>7d} {np.median(r['vertices']):>8.0f} "
               f"{np.median(r['gain_evals']):>10.0f} | {mp(r['total']):>15} | {mp(r['cpu']):>15} | {mp(r['graph']):>13} | "
               f"{mp(r['gain']):>13} | {mp(r['dijkstra']):>11} | {mp(r['other']):>11}")
+    if args.baseline is not None:
+        print()
+        print("\n".join(paired(args.baseline, *worlds[0.2], args.iterations, args.runs, args.seed, args.mapped_radius)))
     print()
     print("paper (Table I): 605.53 ms at 1000 vertices (ANYmal C, i7-8850H, 6 cores); "
           "278.59 ms at 500 vertices (RMF-Obelix, ARM A311D)")
