@@ -182,7 +182,16 @@ class VoxelBackend(WorldBackend):
         return TeamNetwork(views, team, base_location, initial.to_dict())
 
     def figures(self, mission: "Mission") -> dict[str, Any]:
-        return {"free_volume_m3": round(len(self.truth) * self.world.voxel_size_m ** 3, 1)}
+        """The world's free volume and, for a team, ``overlap_fraction``: the share of
+        the volume the team observed that more than one robot observed."""
+        out: dict[str, Any] = {"free_volume_m3": round(len(self.truth) * self.world.voxel_size_m ** 3, 1)}
+        if len(self.robots) > 1:
+            seen_by = np.zeros(len(self.truth), dtype=np.uint16)
+            for robot in self.robots.values():
+                seen_by += robot.onboard_map.occupancy.reshape(-1)[self.truth] == 0
+            seen = np.count_nonzero(seen_by)
+            out["overlap_fraction"] = round(np.count_nonzero(seen_by > 1) / seen, 5) if seen else 0.0
+        return out
 
     def robot_figures(self, name: str, lost: Mapping[str, str]) -> dict[str, Any]:
         start = {"start": [round(float(c), 3) for c in self.starts[name]],

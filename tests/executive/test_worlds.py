@@ -86,3 +86,24 @@ robots:
     with pytest.raises(DelveError, match="'range_m' does not apply to a graph world") as err:
         load_scenario(bad, include_path=[DATA])
     assert err.value.line == 5
+
+
+def test_a_voxel_team_reports_the_share_it_observed_twice(tmp_path):
+    """Two robots standing at one start see nearly the same tunnel: most of what the team
+    observed, more than one robot observed. One robot alone has no overlap figure."""
+    def figures(robots: str):
+        scenario = tmp_path / "team.yaml"
+        scenario.write_text(f"""name: team
+seed: 3
+duration_s: 4
+world: {{generator: tunnel_network, total_length_m: 60, loops: 0}}
+robots:
+{robots}""")
+        mission = Mission(load_scenario(scenario))
+        mission.run()
+        return mission.backend.figures(mission)
+
+    tree = DATA.parents[2] / "trees" / "gbplanner_explorer.yaml"
+    pair = figures(f"  - {{name: a, platform: legged, tree: {tree}}}\n  - {{name: b, platform: legged, tree: {tree}}}\n")
+    assert 0.5 < pair["overlap_fraction"] <= 1.0
+    assert "overlap_fraction" not in figures(f"  - {{name: a, platform: legged, tree: {tree}}}\n")
