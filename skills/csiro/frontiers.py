@@ -25,11 +25,11 @@ class UpdateFrontiers(Skill):
     Every tick: the range sensors' sweeps (``take_lidar_scans``) go into the point cache, and
     the robot's position into the topometric map (a node every ~3 m) and its trajectory points
     (every 5 s). When a sweep came and the frontier update is due (d_min of motion, T_min apart;
-    or the last update saw too little) the frontiers of Algorithm 2 are updated from the cache's
-    cloud seen from the LiDAR; a ground robot plans the
-    observer of every new or changed frontier on the current mesh (equation 13), hangs it off
-    the topometric map and joins its current node to the trajectory nodes the mesh reaches.
-    A degenerate cloud is no error: nothing changes, ``csiro_no_view`` says why (once per cause).
+    or the last update saw too little) the frontiers of Algorithm 2 are updated from the
+    cache's cloud seen from the LiDAR; a ground robot plans the observer of every new or changed
+    frontier on the current mesh (equation 13), hangs it off the topometric map and joins its
+    current node to the trajectory nodes the mesh reaches. A degenerate cloud is no error:
+    nothing changes, ``csiro_no_view`` says why (once per cause).
 
     Writes ``csiro_frontier_count`` (the robot's own frontiers). Logs ``csiro_frontiers`` when
     frontiers appear or go. Returns RUNNING.
