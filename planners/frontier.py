@@ -109,10 +109,10 @@ def viewpoint_nodes(graph: NavGraph, distances: np.ndarray,
 
 def in_view(sensor: np.ndarray, points: np.ndarray, view_up_deg: float, slack_m: float) -> np.ndarray:
     """Whether each point is at most ``view_up_deg`` above the horizontal seen from its
-    ``sensor`` (rows pair up, or broadcast), give or take ``slack_m`` of height."""
+    ``sensor`` (rows pair up), give or take ``slack_m`` of height."""
     diff = points - sensor
-    level = np.hypot(diff[..., 0], diff[..., 1])
-    return diff[..., 2] <= level * np.tan(np.radians(min(view_up_deg, 89.9))) + slack_m
+    level = np.hypot(diff[:, 0], diff[:, 1])
+    return diff[:, 2] <= level * np.tan(np.radians(min(view_up_deg, 89.9))) + slack_m
 
 
 #: A LiDAR ray that meets a wall of unknown space at more than this angle from its
@@ -292,8 +292,8 @@ def nearest_frontier(
     with a clear line. Goals that ``accept`` refuses are passed over with their cluster
     (the caller's, say a goal where the robot stands already). A far goal approaches a
     frontier the map cannot reach yet; a weight above 1 makes the node nearest the
-    frontier win over the robot's own.
-    Candidate nodes are thinned to one per ``node_spacing_m`` cell.
+    frontier win over the robot's own. Candidate nodes are thinned to one per
+    ``node_spacing_m`` cell.
     """
     nodes = viewpoint_nodes(graph, distances, node_spacing_m)
     if len(nodes) == 0 or not clusters:
@@ -305,8 +305,7 @@ def nearest_frontier(
         return None
     cand = nodes[np.concatenate([np.asarray(n, dtype=np.int64) for n in near])]
     offset = np.linalg.norm(centroids[owner] - graph.positions[cand], axis=1)
-    lift = np.array([0.0, 0.0, sensor_height_m])
-    sensor = graph.positions[cand] + lift
+    sensor = graph.positions[cand] + np.array([0.0, 0.0, sensor_height_m])
     picks = [c.voxels[np.linspace(0, c.size - 1, min(c.size, VIEW_SAMPLES)).astype(np.int64)]
              for c in clusters]
     sizes = np.array([len(p) for p in picks])
