@@ -18,8 +18,7 @@ import numpy as np
 from ...planners.cohort import CohortParams
 from ...skills.base import Param, short_repr
 from ...skills import cohort as cohort_skills
-from ...skills.cohort.hub import HOME_SERVICE, HUB_SERVICE
-from ...skills.cohort.robot import PARAMS_SERVICE
+from ...skills.cohort.hub import HOME_SERVICE, HUB_SERVICE, PARAMS_SERVICE
 from ..errors import DelveError
 from ..worlds import BASE
 from .base import TeamStrategy

@@ -18,11 +18,8 @@ from ...planners.cohort import CohortParams
 from ...planners.geometry import xyz
 from ..base import AgentContext, Param, Skill, mailbox
 from ..motion import GoTo
+from .hub import ASSIGNMENT, PARAMS_SERVICE, REQUEST, SUBMAP
 
-#: ``ctx.services`` key of the team's :class:`CohortParams`.
-PARAMS_SERVICE = "cohort_params"
-#: Message kinds.
-SUBMAP, REQUEST, ASSIGNMENT = "cohort_submap", "cohort_request", "cohort_assignment"
 #: Who the hub is on the radio.
 HUB = "base"
 #: ``ctx.services`` key of the agent's count of requests to the hub.
@@ -249,5 +246,4 @@ class FollowHubPath(GoTo):
         return super()._path(grid)
 
 
-__all__ = ["ASSIGNMENT", "HUB", "PARAMS_SERVICE", "REQUEST", "REQUEST_COUNT", "SUBMAP", "CallHub", "FollowHubPath", "SendSubmaps",
-           "cohort_params", "linked"]
+__all__ = ["HUB", "REQUEST_COUNT", "CallHub", "FollowHubPath", "SendSubmaps", "cohort_params", "linked"]

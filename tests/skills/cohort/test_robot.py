@@ -3,17 +3,17 @@ hub, re-positioning, the lost-link rule) on the fake robot, with a scripted hub.
 from __future__ import annotations
 
 import numpy as np
+import py_trees
 import pytest
 from delve.planners.cohort import CohortParams
 from delve.planners.gbplanner2 import synthetic as syn
 from delve.planners.occupancy import FREE, UNKNOWN
 from delve.skills.cohort.lost_link import CohortTimer, ExplorationOver, ReturnToLinkPoint
-from delve.skills.cohort.robot import ASSIGNMENT, REQUEST, SUBMAP, CallHub, FollowHubPath, SendSubmaps
+from delve.skills.cohort.hub import ASSIGNMENT, REQUEST, SUBMAP
+from delve.skills.cohort.robot import CallHub, FollowHubPath, SendSubmaps
 from py_trees.common import Status
 
 from ..fakes import FakeRobot, bb, body, events, make_ctx, run
-
-import py_trees
 
 
 @pytest.fixture(scope="module")

@@ -1,0 +1,56 @@
+"""COHORT missions to the end (small worlds, short runs): the lost-link rule, the hub
+sending two robots into different branches of a fork, and determinism."""
+import json
+
+import numpy as np
+import pytest
+
+from delve.executive.outputs import strip_wall_clock
+
+from .conftest import DATA, run_scenario
+
+pytestmark = pytest.mark.slow
+
+
+def robot_events(mission, robot: str) -> list[dict]:
+    return [e for e in mission.state.events if e.get("agent") == robot and e["event"].startswith("cohort_")]
+
+
+def test_out_of_reach_at_its_call_the_robot_explores_t_ce_more_then_backtracks_to_its_last_link_point():
+    mission, _ = run_scenario(DATA / "cohort_lost_link.yaml")
+    params = mission.team.cohort
+    events = robot_events(mission, "a")
+    calls = [e for e in events if e["event"] == "cohort_call"]
+    # The first call in reach stores a link point; a later call finds the hub out of reach.
+    first_link = next(e for e in calls if e["reached"])
+    failed = next(e for e in calls if not e["reached"] and e["t"] > first_link["t"])
+    after = [e for e in events if e["t"] >= failed["t"]]
+    assert after[1]["event"] == "cohort_extra_exploration"  # the box was not explored
+    back = next(e for e in after if e["event"] == "cohort_backtrack")
+    assert back["t"] == pytest.approx(failed["t"] + params.extra_explore_s, abs=0.3)
+    assert back["to"] == first_link["position"]
+    assert np.linalg.norm(np.subtract(first_link["position"][:2], mission.robots["a"].home[:2])) > 5.0
+    arrived = next(e for e in after if e["event"] == "cohort_link_point")
+    assert arrived["at"] == first_link["position"] and arrived["linked"] is True
+    again = next(e for e in after if e["event"] == "cohort_call" and e["t"] >= arrived["t"])
+    assert again["reached"] is True
+
+
+def test_the_hub_sends_two_robots_into_different_branches_of_a_fork():
+    """The fork is at the portal: one tunnel runs north (y > 0), one south."""
+    mission, _ = run_scenario(DATA / "cohort_fork.yaml")
+    first = {r: next(e for e in robot_events(mission, r) if e["event"] == "cohort_assignment_received")
+             for r in ("a", "b")}
+    assert all(f["frontier"] is not None for f in first.values())
+    assert np.sign(first["a"]["frontier"][1]) != np.sign(first["b"]["frontier"][1])
+    ends = {r: mission.robots[r].position[1] for r in ("a", "b")}
+    assert min(abs(y) for y in ends.values()) > 10.0 and np.sign(ends["a"]) != np.sign(ends["b"])
+    assert np.sign(ends["a"]) == np.sign(first["a"]["frontier"][1])
+
+
+def test_same_seed_same_report_and_log(tmp_path):
+    _, a = run_scenario(DATA / "cohort_fork.yaml", tmp_path / "a")
+    _, b = run_scenario(DATA / "cohort_fork.yaml", tmp_path / "b")
+    assert json.dumps(strip_wall_clock(a)) == json.dumps(strip_wall_clock(b))
+    assert a["cohort"]["submaps_at_hub"] > 0 and len(a["cohort"]["assignments"]) >= 2
+    assert (tmp_path / "a" / "log.jsonl").read_bytes() == (tmp_path / "b" / "log.jsonl").read_bytes()
