@@ -61,6 +61,20 @@ def test_is_free(twin):
     assert twin.is_free(np.zeros((0, 3))).shape == (0,)
 
 
+def test_is_free_of_one_point_answers_as_for_many(twin):
+    """One point (a robot's probe) takes a shortcut on plain floats: the same answers,
+    on voxel faces, just inside them and outside the grid."""
+    rng = np.random.default_rng(3)
+    lo, hi = twin.bounds_min - 1.0, twin.bounds_max + 1.0
+    faces = twin.origin + rng.integers(-3, np.array(twin.shape) + 3, size=(3000, 3)) * twin.voxel_size_m
+    pts = np.concatenate([rng.uniform(lo, hi, size=(3000, 3)), faces, np.nextafter(faces, -np.inf)])
+    many = twin.is_free(pts)
+    assert 0 < many.sum() < len(pts)
+    np.testing.assert_array_equal([twin.is_free(p[None])[0] for p in pts], many)
+    with np.errstate(invalid="ignore"):  # NaN takes the array path, which casts it
+        assert not twin.is_free(np.array([[np.nan, 0.0, 1.0]]))[0]
+
+
 def test_rays_along_and_across_tunnel(twin):
     o = np.array([15.0, 0.0, 1.0])
     dirs = np.array([[1.0, 0, 0], [-1.0, 0, 0], [0, 1.0, 0], [0, -1.0, 0],
