@@ -106,10 +106,7 @@ class LocalMap:
         Computed on the transposed (3, N) coordinates and returned as an (N, 3) view of
         them: numpy broadcasts an (N, 3) array against a 3-vector one short row at a
         time, several times slower on the batches of Algorithm 2."""
-        p = np.asarray(points, float)
-        if p.ndim != 2:
-            idx = np.floor((p - self.origin) / self.voxel_size_m).astype(np.int64)
-            return idx, np.all((idx >= 0) & (idx < np.array(self.shape)), axis=-1)
+        p = np.asarray(points, float).reshape(-1, 3)
         idx_t = np.floor((p.T - self.origin[:, None]) / self.voxel_size_m).astype(np.int64)
         below = idx_t.view(np.uint64) < self._shape_u[:, None]  # a negative index wraps to a huge one
         return idx_t.T, below[0] & below[1] & below[2]
