@@ -13,7 +13,21 @@ from ...planners.csiro.topometric import frontier_node
 from ...planners.geometry import xyz
 from ..base import Param
 from ..motion import GoTo
+from ..navigation import navigator
 from .state import CsiroState, csiro_state
+
+
+def reachable_near(ctx: Any, robot: Any, point: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    """The path to the node of the robot's navigation graph that it can reach and that lies
+    nearest ``point``, and that node's position; None when the robot is off its graph."""
+    plan = navigator(ctx, robot).from_robot()
+    if plan is None:
+        return None
+    reach = np.flatnonzero(np.isfinite(plan.distances))
+    if not len(reach):
+        return None
+    node = int(reach[np.argmin(np.linalg.norm(plan.graph.positions[reach] - point, axis=1))])
+    return plan.path_to(node), plan.graph.positions[node].copy()
 
 
 class FollowFrontierGoal(GoTo):
@@ -125,12 +139,21 @@ class FollowFrontierGoal(GoTo):
         return Status.FAILURE
 
     def _path(self, grid: Any) -> tuple[np.ndarray | None, str, str, str]:
+        """The topometric map's path first (ground robot), then ``GoTo``'s; where that finds none
+        (an observer beyond what the onboard map's graph covers yet), the way to the reachable
+        place nearest the goal, when it brings the robot nearer by ``progress_m`` at least."""
         st, r = csiro_state(self.ctx), self.robot
         if self.replans == 0 and not r.mobility.aerial:
             path = st.topometric.path(r.position, frontier_node(self.key))
             if path is not None and len(path.points) > 2:
                 return path.points[1:-1], "topometric", "", ""   # the goal is appended by GoTo
-        return super()._path(grid)
+        path, source, code, why = super()._path(grid)
+        if path is None and code == "no_path":
+            near = reachable_near(self.ctx, r, self.goal)
+            if near is not None and (np.linalg.norm(near[1] - self.goal) + st.selection.progress_m
+                                     <= np.linalg.norm(r.position - self.goal)):
+                return near[0], "navigator, nearest reachable", "", ""
+        return path, source, code, why
 
 
 __all__ = ["FollowFrontierGoal"]

@@ -13,7 +13,7 @@ from ...planners.csiro.selection import select_uav_frontier, select_ugv_frontier
 from ...planners.csiro.topometric import frontier_node
 from ...planners.geometry import xyz
 from ..base import Param, Skill
-from ..navigation import navigator
+from .follow import reachable_near
 from .frontiers import body_lift
 from .state import csiro_state
 
@@ -98,19 +98,9 @@ class SelectUavFrontier(_Select):
         if picked is None:
             return self.none_left()
         frontier, st.momentum = picked
-        return self.chosen((name, frontier.id), self._reachable_near(frontier.mean),
+        near = reachable_near(self.ctx, r, frontier.mean)
+        return self.chosen((name, frontier.id), frontier.mean if near is None else near[1],
                            area_m2=round(frontier.area, 2))
-
-    def _reachable_near(self, point: np.ndarray) -> np.ndarray:
-        """The reachable navigation node nearest ``point`` (``point`` itself when none)."""
-        plan = navigator(self.ctx, self.robot).from_robot()
-        if plan is None:
-            return np.asarray(point, float)
-        reach = np.flatnonzero(np.isfinite(plan.distances))
-        if not len(reach):
-            return np.asarray(point, float)
-        positions = plan.graph.positions[reach]
-        return positions[int(np.argmin(np.linalg.norm(positions - point, axis=1)))].copy()
 
 
 __all__ = ["SelectUavFrontier", "SelectUgvFrontier"]

@@ -2,6 +2,8 @@
 the frontier changes, and applies the failure rule (no 1 m of progress in 15 s)."""
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import py_trees
 from delve.skills.csiro import FollowFrontierGoal, SelectUavFrontier, SelectUgvFrontier, UpdateFrontiers, \
@@ -62,3 +64,16 @@ def test_uav_completes_a_frontier_within_the_blacklist_radius(tunnel, tunnel_poi
     node = FollowFrontierGoal("follow", ctx, tolerance_m=0.5)
     assert run(node, ctx, robot, ticks=40) == Status.SUCCESS
     assert events(ctx, "csiro_goal_done")[0]["why"] == "complete" and key[1] in st.blacklist
+
+
+def test_an_observer_beyond_the_onboard_map_s_graph_is_approached_as_near_as_it_reaches(tunnel):
+    robot, ctx, st, node = selected(tunnel, frontiers_at=(12.0,))
+    goal = np.array([12.0, 30.0, 1.5])                    # beyond the tunnel's wall: no path to it
+    st.summaries[("r1", 0)] = replace(st.summaries[("r1", 0)], observer=goal - [0.0, 0.0, 0.5])
+    st.topometric.detach_frontier(("r1", 0))                # no topometric path either
+    py_trees.blackboard.Blackboard.set("/r1/goal", goal.tolist())
+    node = FollowFrontierGoal("follow", ctx, max_replans=0)
+    run(node, ctx, robot, ticks=3)
+    assert robot.paths and "nearest reachable" in events(ctx, "goto")[0]["source"]
+    end = robot.paths[0][-2]                              # GoTo appends the goal itself
+    assert abs(end[0] - 12.0) < 1.0 and end[1] > 6.5     # the tunnel's side nearest the goal
