@@ -109,16 +109,12 @@ class ReturnToLinkPoint(GoTo):
         return Status.SUCCESS if ok else self._next("no link there")
 
     def _fail(self, code: str, reason: str) -> Status:
-        if self.points:
-            return self._next(reason)
-        return super()._fail(code, reason)
+        return self._next(reason) if self.points else super()._fail(code, reason)
 
     def _next(self, why: str) -> Status:
         """Go on to the link point before this one; FAILURE when none is left."""
         if not self.points:
-            self.feedback_message = "no link point offers a link"
-            self.write("goto_failure", "not_reached")
-            return Status.FAILURE
+            return super()._fail("not_reached", "no link point offers a link")
         self.goal, self.last_end, self.replans, self.moving = self.points.pop(), None, 0, False
         self.feedback_message = f"{why}: on to {xyz(self.goal, 1)}"
         return Status.RUNNING

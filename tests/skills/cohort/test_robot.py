@@ -249,6 +249,7 @@ def test_return_ends_at_home_and_fails_when_no_point_links(tunnel):
     assert run(node, ctx, robot) == Status.FAILURE
     assert np.linalg.norm(robot.position - robot.home) <= 0.5
     assert [e["linked"] for e in events(ctx, "cohort_link_point")] == [False, False]
+    assert bb("goto_failure") == "not_reached" and events(ctx, "goto_failed")
 
 
 def test_request_ids_count_per_agent_across_call_nodes(robot):
