@@ -7,7 +7,7 @@ from delve.skills.csiro import CONFIG_SERVICE, CsiroConfig, ReturnToComms, Retur
     csiro_state
 from py_trees.common import Status
 
-from ..fakes import FakeMessage, FakeRobot, bb, body, events, make_ctx, run
+from ..fakes import FakeRobot, bb, body, events, make_ctx, run
 
 
 def walked(tunnel, sync_s: float = 30.0):
