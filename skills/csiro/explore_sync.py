@@ -7,7 +7,6 @@ A tree runs them in a sequence: ``SyncDue`` -> ``ReturnToComms`` -> ``Uplink`` -
 """
 from __future__ import annotations
 
-from typing import Any
 
 import numpy as np
 from py_trees.common import Status
@@ -18,7 +17,7 @@ from ..base import Param, Skill
 from ..motion_base import PathMotion
 from ..navigation import navigator
 from ..robot import PathStatus
-from .state import BASE, csiro_config, csiro_state
+from .state import BASE, CsiroState, csiro_config, csiro_state
 
 
 class SyncDue(Skill):
@@ -150,7 +149,7 @@ class ReturnToRegion(PathMotion):
         self._explore_again(st)
         return Status.FAILURE
 
-    def _explore_again(self, st: Any) -> None:
+    def _explore_again(self, st: CsiroState) -> None:
         """The region is forgotten and the time out of contact counts from now: the explore-sync
         time is time spent exploring, not driving back to the region."""
         st.region = None
