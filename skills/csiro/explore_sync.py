@@ -7,7 +7,6 @@ A tree runs them in a sequence: ``SyncDue`` -> ``ReturnToComms`` -> ``Uplink`` -
 """
 from __future__ import annotations
 
-
 import numpy as np
 from py_trees.common import Status
 from py_trees.ports import PortInformation
