@@ -113,7 +113,7 @@ float, 2.0, "how often the target cluster is re-checked", exclusive_minimum=0),
         self.goal, self.arrived_s = None, None
         nav = navigator(self.ctx, self.robot)
         grid = nav.grid()
-        candidates = frontier_voxels(grid)
+        candidates = nav.frontier_voxels()  # incremental, equal to frontier_voxels(grid)
         candidates = candidates[~np.isin(candidates, self.blacklist)]
         # First on the cached navigation graph; if that ends at the robot, on a fresh one.
         for fresh in (False, True):
