@@ -30,6 +30,10 @@ from .robot import PathStatus, Robot
 
 #: ``ctx.services`` key of the agent's :class:`PlannerService`.
 SERVICE = "gbplanner"
+#: The collision box is this much narrower than the robot on each side (half a voxel of
+#: the 0.2 m maps the rule was tuned on), so that rounding it out to whole voxels does
+#: not make it wider than the robot.
+BOX_SIDE_ALLOWANCE_M = 0.1
 
 
 @dataclass
@@ -53,13 +57,16 @@ def robot_config(robot: Robot, overrides: dict[str, Any] | None = None) -> GBPla
     robot's remaining endurance at each iteration (T_end is the robot's, not the
     configuration's).
 
-    The collision box's horizontal sides are the robot's diameter less one voxel of
-    its map: the planner rounds the box out to whole voxels on each side (a 0.8 m box
-    covers five 0.2 m voxels, 1.0 m), which would make the robot a voxel wider than it
-    is and shut it out of squeezes it fits through."""
+    The collision box's horizontal sides are the robot's diameter less
+    :data:`BOX_SIDE_ALLOWANCE_M` on each side: the planner rounds the box out to whole
+    voxels (a 0.8 m box covers five 0.2 m voxels, 1.0 m), which would make the robot a
+    voxel wider than it is and shut it out of squeezes it fits through. The allowance is
+    in metres, not voxels: less half a voxel of a 0.4 m map left a box of one voxel,
+    half the 0.8 m robot, whose paths hugged the rock until the global graph's edges
+    along them were cut."""
     mob = robot.mobility
     preset = robot.platform if robot.platform in ("legged", "aerial") else ("aerial" if mob.aerial else "legged")
-    radius = max(mob.radius_m - 0.5 * robot.onboard_map.voxel_size_m, 0.5 * robot.onboard_map.voxel_size_m)
+    radius = max(mob.radius_m - BOX_SIDE_ALLOWANCE_M, 0.5 * robot.onboard_map.voxel_size_m)
     cfg = GBPlannerConfig.preset(preset).with_robot_limits(
         speed_mps=mob.speed_mps,
         body_height_m=mob.body_height_m,

@@ -10,7 +10,9 @@ import pytest
 from delve.executive.errors import DelveError
 from delve.executive.tree_loader import build_tree, check_context
 from delve.planners.gbplanner2 import synthetic as syn
+from delve.planners.gbplanner2.local_map import LocalMap
 from delve.planners.gbplanner2.local_planner import ShrinkingLocalPlanner
+from delve.planners.occupancy import FREE, OCCUPIED, Grid
 from delve.skills.gbplanner import SERVICE, Explore, gbplanner, parse_bbox, robot_config, stable_seed
 from delve.skills.homing import Home
 from py_trees.common import Status
@@ -55,6 +57,21 @@ def test_robot_config_takes_the_platform_preset_and_the_robot_limits(half_mapped
     cfg = robot_config(aerial, {"num_vertices_max": 300})
     assert cfg.robot_type == "aerial" and cfg.num_vertices_max == 300
     assert cfg.clustering_radius_m == 1.0 and cfg.sensor_fov_vertical_deg == 90.0
+
+
+@pytest.mark.parametrize("voxel_m", [0.2, 0.4])
+def test_the_collision_box_keeps_the_robot_clear_of_rock_at_any_voxel_size(voxel_m):
+    """A 0.8 m aerial robot in a free voxel whose neighbour is rock would touch it: its
+    box must not be free there, on a 0.4 m map as on a 0.2 m one (the box was one 0.4 m
+    voxel, and paths hugged the rock)."""
+    occ = np.full((9, 9, 9), FREE, np.int8)
+    occ[5, :, :] = OCCUPIED
+    grid = Grid(occ, np.zeros(3), voxel_m)
+    cfg = robot_config(FakeRobot(grid, np.full(3, 4.5 * voxel_m), platform="aerial"))
+    local = LocalMap(grid, np.zeros(3), np.full(3, 9 * voxel_m), cfg)
+    beside, clear = np.array([[4.5, 4.5, 4.5], [3.5, 4.5, 4.5]]) * voxel_m
+    assert not local.is_box_free(beside[None])[0]
+    assert local.is_box_free(clear[None])[0]
 
 
 def test_one_planner_per_agent_seeded_from_the_agent_name(half_mapped):
