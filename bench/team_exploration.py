@@ -163,7 +163,8 @@ def fmt(value: float | None, spec: str = ".0f", none: str = "-") -> str:
 
 
 def print_tables(runs: list[Run], worlds: list[str], methods: list[str]) -> None:
-    print("| world | method | seed | T90 (s) | coverage | at base | distance (m) | overlap | scored | succeeded | wall (s) |")
+    print("| world | method | seed | T90 (s) | coverage | at base | distance (m) | overlap | scored | succeeded "
+          "| wall (s) |")
     print("|---|---|---|---|---|---|---|---|---|---|---|")
     for r in sorted(runs, key=lambda r: (worlds.index(r.world), methods.index(r.method), r.seed)):
         print(f"| {r.world} | {r.method} | {r.seed} | {fmt(r.t90_s, '.0f', 'not reached')} | {r.coverage:.1%} | "
@@ -222,17 +223,20 @@ def main(argv: list[str] | None = None) -> int:
     print("$ " + " ".join(shlex.quote(a) for a in [Path(sys.executable).name, *sys.argv]))
     print()
     for name, spec in worlds.items():
-        print(f"world {name}: {spec['generator']}({', '.join(f'{k}={v}' for k, v in spec.items() if k != 'generator')})")
+        params = ", ".join(f"{k}={v}" for k, v in spec.items() if k != "generator")
+        print(f"world {name}: {spec['generator']}({params})")
     print(f"robots: aerial (RMF-Obelix-like), endurance {ENDURANCE_S:.0f} s, mission limit {args.duration_s:.0f} s, "
           f"radio range {RADIO_RANGE_M:.0f} m, {artifacts} artifacts; seeds {seeds}; "
-          f"{args.scheduler or f'{args.jobs} worker(s)'}; load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
+          f"{args.scheduler or f'{args.jobs} worker(s)'}; "
+          f"load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
     print()
     t0 = time.perf_counter()
     if args.out:
         runs = run_sweep(worlds, args.methods, seeds, args.duration_s, artifacts, args.out, args.jobs, args.scheduler)
     else:
         with tempfile.TemporaryDirectory(prefix="team_exploration_") as tmp:
-            runs = run_sweep(worlds, args.methods, seeds, args.duration_s, artifacts, Path(tmp), args.jobs, args.scheduler)
+            runs = run_sweep(worlds, args.methods, seeds, args.duration_s, artifacts, Path(tmp), args.jobs,
+                             args.scheduler)
     print_tables(runs, list(worlds), args.methods)
     print(f"\n{len(runs)} runs in {time.perf_counter() - t0:.0f} s wall")
     return 0 if runs else 1
