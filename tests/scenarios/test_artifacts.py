@@ -52,7 +52,7 @@ def test_a_lost_robots_reports_count_as_undelivered(tmp_path):
     text = (DATA / "artifacts_small.yaml").read_text().replace("duration_s: 900", "duration_s: 400")
     path = tmp_path / "lost.yaml"
     path.write_text(text.replace("../../../trees", str(DATA.parent.parent.parent / "trees"))
-                    + "faults:\n  - {at_s: 220, kind: lost, robot: anymal}\n")
+                    + "faults:\n  - {at_s: 300, kind: lost, robot: anymal}\n")
     mission, report = run_scenario(path, tmp_path / "out")
     art = report["artifacts"]
     made = [e for e in mission.state.events if e["event"] == "artifact_reported"]
