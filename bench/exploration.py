@@ -43,7 +43,6 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
-import yaml
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -102,21 +101,11 @@ def sweep_doc(worlds: dict[str, dict], seeds: list[int]) -> dict:
 
 def run_sweep(worlds: dict[str, dict], seeds: list[int], out: Path, jobs: int, scheduler: str | None) -> list[Run]:
     """Run the sweep into ``out``; its rows as Runs (a failed run stops the bench)."""
-    from delve.executive.sweep import run_sweep as sweep_runs
-    from delve.executive.sweep_spec import load_sweep
+    from bench_sweep import run_bench_sweep
 
-    out.mkdir(parents=True, exist_ok=True)
     first = next(iter(worlds.values()))
-    (out / "scenario.yaml").write_text(yaml.safe_dump(scenario_doc(first, TREES["frontier"], seeds[0])))
-    (out / "sweep.yaml").write_text(yaml.safe_dump(sweep_doc(worlds, seeds), sort_keys=False))
-    t0 = time.perf_counter()
-
-    def done(n: int, total: int, spec, record: dict) -> None:
-        print(f"  [{n}/{total}] {spec.run_id} {record['status']} ({time.perf_counter() - t0:.0f} s)",
-              file=sys.stderr, flush=True)
-
-    result = sweep_runs(load_sweep(out / "sweep.yaml"), out / "results", workers=None if scheduler else jobs,
-                        scheduler=scheduler, progress=done)
+    result = run_bench_sweep(out, scenario_doc(first, TREES["frontier"], seeds[0]), sweep_doc(worlds, seeds), jobs,
+                             scheduler)
     failed = result.table[result.table["status"] != "ok"]
     if len(failed):
         raise SystemExit("runs failed: " + "; ".join(f"{r.run_id}: {r.error}" for r in failed.itertuples()))

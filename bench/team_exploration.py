@@ -42,7 +42,6 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
-import yaml
 
 ROOT = Path(__file__).resolve().parent.parent
 TREES = ROOT / "trees"
@@ -123,21 +122,10 @@ def _number(row, column: str) -> float | None:
 def run_sweep(worlds: dict[str, dict], methods: list[str], seeds: list[int], duration_s: float, artifacts: int,
               out: Path, jobs: int, scheduler: str | None) -> list[Run]:
     """Run the sweep into ``out``; its finished rows as Runs (a failed run is printed and left out)."""
-    from delve.executive.sweep import run_sweep as sweep_runs
-    from delve.executive.sweep_spec import load_sweep
+    from bench_sweep import run_bench_sweep
 
-    out.mkdir(parents=True, exist_ok=True)
     first = scenario_doc(next(iter(worlds.values())), seeds[0], duration_s, artifacts)
-    (out / "scenario.yaml").write_text(yaml.safe_dump(first))
-    (out / "sweep.yaml").write_text(yaml.safe_dump(sweep_doc(worlds, methods, seeds), sort_keys=False))
-    t0 = time.perf_counter()
-
-    def done(n: int, total: int, spec, record: dict) -> None:
-        print(f"  [{n}/{total}] {spec.run_id} {record['status']} ({time.perf_counter() - t0:.0f} s)",
-              file=sys.stderr, flush=True)
-
-    result = sweep_runs(load_sweep(out / "sweep.yaml"), out / "results", workers=None if scheduler else jobs,
-                        scheduler=scheduler, progress=done)
+    result = run_bench_sweep(out, first, sweep_doc(worlds, methods, seeds), jobs, scheduler)
     for r in result.table[result.table["status"] != "ok"].itertuples():
         print(f"FAILED {r.run_id}: {r.error}")
     runs = []
