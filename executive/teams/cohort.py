@@ -134,14 +134,23 @@ class Cohort(TeamStrategy):
         and the points where robots spoke to the hub."""
         hub = self.hub(mission)
         if hub is not None:
-            for i, rec in enumerate(hub.assignments):
+            world = mission.world
+            lo = np.asarray(getattr(world, "bounds_min", (-np.inf,) * 3), float)[:2]
+            hi = np.asarray(getattr(world, "bounds_max", (np.inf,) * 3), float)[:2]
+            boxes = targets = 0
+            for rec in hub.assignments:
                 if rec.result.box_min is None:
                     continue
                 (x0, y0), (x1, y1) = rec.result.box_min[:2], rec.result.box_max[:2]
-                ax.plot([x0, x1, x1, x0, x0], [y0, y0, y1, y1, y0], "--", lw=0.6, color="purple",
-                        label="COHORT box" if i == 0 else None)
+                # A box clipped to the world across (the paper's 360 m on our worlds) restricts
+                # only height; drawn, it would be the world's frame.
+                if not (x0 <= lo[0] and y0 <= lo[1] and x1 >= hi[0] and y1 >= hi[1]):
+                    ax.plot([x0, x1, x1, x0, x0], [y0, y0, y1, y1, y0], "--", lw=0.6, color="purple",
+                            label=None if boxes else "COHORT box")
+                    boxes += 1
                 ax.plot(*rec.result.frontier[:2], "*", ms=8, color="purple",
-                        label="COHORT target" if i == 0 else None)
+                        label=None if targets else "COHORT target")
+                targets += 1
             c = hub.frontier_centroids
             if len(c):
                 ax.plot(c[:, 0], c[:, 1], "D", ms=4, mfc="none", color="darkorange", label="hub frontiers (end)")

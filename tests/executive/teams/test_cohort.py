@@ -107,12 +107,23 @@ def test_the_report_counts_per_robot_and_lists_the_assignments():
     assert cohort_figures([], ["r1"], None)["submaps_at_hub"] == 0
 
 
-def test_the_map_shows_boxes_targets_frontiers_and_calls(tmp_path):
+def drawn_labels(world) -> set[str]:
     mission = SimpleNamespace(agents={"base": SimpleNamespace(ctx=SimpleNamespace(services={"cohort_hub": fake_hub()}))},
                               state=SimpleNamespace(events=[{"event": "cohort_call", "reached": True,
-                                                             "position": [1.0, 0.0, 1.0]}]))
+                                                             "position": [1.0, 0.0, 1.0]}]), world=world)
     fig, ax = plt.subplots()
     Cohort().draw(ax, mission)
     labels = {line.get_label() for line in ax.get_lines()}
     plt.close(fig)
-    assert {"COHORT box", "COHORT target", "hub frontiers (end)", "call to the hub (link)"} <= labels
+    return labels
+
+
+def test_the_map_shows_boxes_targets_frontiers_and_calls():
+    world = SimpleNamespace(bounds_min=(-50.0, -50.0, -5.0), bounds_max=(50.0, 50.0, 10.0))
+    assert {"COHORT box", "COHORT target", "hub frontiers (end)", "call to the hub (link)"} <= drawn_labels(world)
+
+
+def test_a_box_spanning_the_world_across_is_not_drawn():
+    world = SimpleNamespace(bounds_min=(0.0, -5.0, 0.0), bounds_max=(20.0, 9.0, 10.0))
+    labels = drawn_labels(world)
+    assert "COHORT box" not in labels and "COHORT target" in labels
