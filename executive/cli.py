@@ -217,8 +217,9 @@ def _run_with_progress(mission) -> None:
             s = m.state.samples[-1] if m.state.samples else None
             states = " ".join(f"{n}:{a.root.status.value}" for n, a in m.agents.items() if n != "base")
             cov = f"coverage {s.team:.0%}" if s else ""
-            bar.update(task, completed=min(m.clock.now_s, m.duration_s),
-                       status=f"t={m.clock.now_s:6.0f}s {cov} {states}")
+            # After the end, the clock runs on while the radio delivers what is queued: show the end.
+            t = m.clock.now_s if m.finished_s is None else m.finished_s
+            bar.update(task, completed=min(t, m.duration_s), status=f"t={t:6.0f}s {cov} {states}")
 
         mission.run(progress=update)
         bar.update(task, completed=mission.duration_s)
