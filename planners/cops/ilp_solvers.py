@@ -32,10 +32,12 @@ from __future__ import annotations
 import math
 import os
 import re
+import sys
 import tempfile
 import time
 import warnings
 from collections import defaultdict
+from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any
 
@@ -149,6 +151,22 @@ def warm_values(model: ConnectivityModel) -> dict[int, float] | None:
     return out
 
 
+
+@contextmanager
+def _stdout_silenced():
+    """Point the process's standard output (file descriptor 1) at /dev/null for the
+    block: highspy's ``Highs()`` prints HiGHS's banner from C++ while it is built,
+    before ``output_flag`` can be set (ERGO-Code/HiGHS#1702, #2749)."""
+    sys.stdout.flush()
+    saved = os.dup(1)
+    try:
+        with open(os.devnull, "wb") as null:
+            os.dup2(null.fileno(), 1)
+        yield
+    finally:
+        os.dup2(saved, 1)
+        os.close(saved)
+
 def solve_highs(model: ConnectivityModel, opts: SolverOptions, limits: SolveLimits) -> Outcome:
     """Hand the model to HiGHS as arrays (much faster than pulp's column-by-column
     transfer), solve it within ``limits`` and copy the solution back into the pulp
@@ -200,7 +218,8 @@ def solve_highs(model: ConnectivityModel, opts: SolverOptions, limits: SolveLimi
     kint, kcont = highspy.HighsVarType.kInteger, highspy.HighsVarType.kContinuous
     lp.integrality_ = [kint if v.cat == pulp.LpInteger else kcont for v in cols]
     lp.sense_ = highspy.ObjSense.kMaximize
-    h = highspy.Highs()
+    with _stdout_silenced():
+        h = highspy.Highs()
     h.setOptionValue("output_flag", False)
     h.setOptionValue("threads", int(opts.threads or 1))
     h.setOptionValue("random_seed", 0)

@@ -86,3 +86,12 @@ def test_a_model_too_large_to_search_gives_its_completed_warm_start():
     plan = solve_connectivity(spread_problem(options=SolverOptions(search_max_rows=100)))
     assert plan.meta["stop"] == "size" and plan.meta["status"] == "feasible" and plan.meta["gap"] is None
     assert validate_plan(plan_network(), plan) == []
+
+
+def test_a_highs_solve_prints_nothing(capfd):
+    net = line(4, [{"name": "r1", "location": "s3"}, {"name": "r2", "location": "s1"}])
+    kw = dict(masters={"base", "r1", "r2"}, requirements=[Requirement(("r1",), ("base",))])
+    capfd.readouterr()
+    solve_connectivity(problem(net, 2, options=SolverOptions(solver="highs"), **kw))
+    print("after")
+    assert capfd.readouterr().out == "after\n"
