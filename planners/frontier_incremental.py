@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from .frontier import FRONTIER_DEPTH, frontier_voxels
-from .navgraph import FACES, Voxels, around
+from .navgraph import FACES, around
 from .occupancy import FREE, UNKNOWN, Grid
 
 
@@ -45,6 +45,6 @@ class FrontierUpdater:
                                  around(changed[occ[changed] == UNKNOWN], grid.shape, self._seen_from)])
         self._flag[retest] = 0
         self._flag[frontier_voxels(grid, among=retest, depth=self.depth)] = 1
-        free = Voxels.free_of(grid).flat
+        free = grid.free_voxels()
         self._frontiers = free[self._flag[free] > 0]
         return self._frontiers

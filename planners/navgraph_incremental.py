@@ -158,12 +158,12 @@ class LeggedGraphUpdater:
 
     def _graph(self, grid: Grid, src: np.ndarray, dst: np.ndarray, w: np.ndarray) -> NavGraph:
         """The nodes in the map's order of free voxels, numbered, and their edges."""
-        free = Voxels.free_of(grid)
-        nodes = free.subset(self.node[free.flat] > 0)
-        positions = grid.to_world(nodes.ijk)
+        free = grid.free_voxels()   # only the nodes' positions are needed, not Voxels of all free ones
+        nodes = free[self.node[free] > 0]
+        positions = grid.to_world(np.stack(np.unravel_index(nodes, grid.shape), axis=1))
         positions[:, 2] += self.body_height_m - 0.5 * self._vox
         n = len(nodes)
-        with _Lookup(len(self.node), nodes.flat) as ids:
+        with _Lookup(len(self.node), nodes) as ids:
             rows, cols = ids[src].astype(np.int64) - 1, ids[dst].astype(np.int64) - 1
         return NavGraph(positions=positions, adjacency=csr_matrix((w, (rows, cols)), shape=(n, n)))
 

@@ -7,6 +7,7 @@ a ray ends in becomes OCCUPIED. Sensing is exact, so no log-odds are needed.
 
 from __future__ import annotations
 
+import functools
 import weakref
 
 import numpy as np
@@ -14,6 +15,18 @@ import numpy as np
 UNKNOWN = -1
 FREE = 0
 OCCUPIED = 1
+
+
+#: Free space is carved by samples this far apart (voxels) along each ray.
+FREE_STEP_VOXELS = 0.7
+
+
+@functools.lru_cache(maxsize=4)
+def _sample_distances(n: int) -> np.ndarray:
+    """Distances (voxels, float32) of the first ``n`` samples along a ray, rounded up to a
+    power of two: ``(k + 0.5) * step`` as the samples of a scan work them out."""
+    n = 1 << max(n - 1, 1023).bit_length()
+    return (np.arange(n, dtype=np.float32) + np.float32(0.5)) * np.float32(FREE_STEP_VOXELS)
 
 
 class ChangeLog:
@@ -59,6 +72,8 @@ class VoxelMap:
         self._free_stale = False
         self._refreed = False
         self._logs: weakref.WeakSet[ChangeLog] = weakref.WeakSet()
+        #: Voxel indices of scan samples fit in int32 (cheaper) when flat indices do.
+        self._axis_dtype = np.int32 if self.occupancy.size < 2**31 else np.int64
 
     @property
     def shape(self) -> tuple[int, int, int]:
@@ -76,22 +91,25 @@ class VoxelMap:
         occ = self.occupancy.reshape(-1)
         # Free space: samples every 0.7 voxel along each ray, up to half a voxel before
         # its hit, worked out per axis in voxel units (float32) to keep it light.
-        step = np.float32(0.7)
+        step = np.float32(FREE_STEP_VOXELS)
         free_len = np.where(hit, ranges / vox - 0.5, max_range_m / vox).astype(np.float32)
         counts = np.maximum(np.floor(free_len / step).astype(np.int64), 0)
         total = int(counts.sum())
         if total:
-            ray = np.repeat(np.arange(len(counts), dtype=np.int32), counts)
             first = np.cumsum(counts) - counts
-            t = (np.arange(total, dtype=np.float32) - first[ray].astype(np.float32) + np.float32(0.5)) * step
+            t = _sample_distances(int(counts.max()))[np.arange(total) - np.repeat(first, counts)]
             start = ((sensor - self.origin) / vox).astype(np.float32)
             d32 = directions.astype(np.float32)
-            axes = [np.floor(start[a] + d32[ray, a] * t).astype(np.int64) for a in range(3)]
+            axes = []
+            for a in range(3):
+                x = np.repeat(d32[:, a], counts)   # each sample's ray's direction
+                x *= t
+                x += start[a]
+                axes.append(np.floor(x, out=x).astype(self._axis_dtype))
             self._mark(axes, occ, UNKNOWN, FREE)
         if hit.any():
             ends = (sensor + directions[hit] * (ranges[hit] + 0.25 * vox)[:, None] - self.origin) / vox
-            axes = [np.floor(ends[:, a]).astype(np.int64) for a in range(3)]
-            self._mark(axes, occ, None, OCCUPIED)
+            self._mark(list(np.floor(ends).astype(np.int64).T), occ, None, OCCUPIED)
         self.version += 1
 
     def _mark(self, axes: list[np.ndarray], occ: np.ndarray, only: int | None, value: int) -> None:
@@ -99,9 +117,13 @@ class VoxelMap:
         grid, or only those currently equal to ``only``."""
         nx, ny, nz = self.shape
         i, j, k = axes
-        inside = (i >= 0) & (i < nx) & (j >= 0) & (j < ny) & (k >= 0) & (k < nz)
+        if i.dtype == np.int32:   # one unsigned comparison per axis tests both bounds
+            inside = (i.view(np.uint32) < nx) & (j.view(np.uint32) < ny) & (k.view(np.uint32) < nz)
+        else:
+            inside = (i >= 0) & (i < nx) & (j >= 0) & (j < ny) & (k >= 0) & (k < nz)
+        # Indices of samples outside the grid may wrap around in int32: they are dropped.
         flat = ((i * ny + j) * nz + k)[inside]
-        flat = flat[occ[flat] == only] if only is not None else flat[occ[flat] != value]
+        flat = (flat[occ[flat] == only] if only is not None else flat[occ[flat] != value]).astype(np.int64)
         if value == FREE:
             self._new_free.append(np.unique(flat))
         else:

@@ -77,8 +77,8 @@ float, 2.0, "how often the target cluster is re-checked", exclusive_minimum=0),
 
     def _remaining(self) -> int:
         """How many of the goal's targets are frontier voxels still."""
-        nav = navigator(self.ctx, self.robot)
-        return len(frontier_voxels(nav.grid(), among=self.goal.targets))
+        m = self.robot.onboard_map   # the occupancy alone: no list of free voxels brought up to date
+        return len(frontier_voxels(Grid(m.occupancy, m.origin, m.voxel_size_m), among=self.goal.targets))
 
     def _goal_done(self) -> bool:
         """Whether to plan again: goal reached and scanned, blocked, or explored meanwhile."""
@@ -114,7 +114,7 @@ float, 2.0, "how often the target cluster is re-checked", exclusive_minimum=0),
         nav = navigator(self.ctx, self.robot)
         grid = nav.grid()
         candidates = nav.frontier_voxels()  # incremental, equal to frontier_voxels(grid)
-        candidates = candidates[~np.isin(candidates, self.blacklist)]
+        candidates = candidates[~_sorted_contains(self.blacklist, candidates)]
         # First on the cached navigation graph; if that ends at the robot, on a fresh one.
         for fresh in (False, True):
             plan = nav.from_robot(force=fresh)
@@ -162,6 +162,15 @@ float, 2.0, "how often the target cluster is re-checked", exclusive_minimum=0),
         return nearest_frontier(plan.graph, plan.distances, clusters, grid,
                                 max_goal_offset_m=self.p["max_goal_offset_m"], view_up_deg=self.robot.view_up_deg,
                                 min_targets=self.p["min_cluster_voxels"], accept=elsewhere)
+
+
+def _sorted_contains(sorted_values: np.ndarray, query: np.ndarray) -> np.ndarray:
+    """Whether each of ``query`` is in ``sorted_values`` (ascending): ``np.isin`` by binary
+    search, without sorting the frontier voxels again at every plan."""
+    if len(sorted_values) == 0:
+        return np.zeros(len(query), dtype=bool)
+    at = np.minimum(np.searchsorted(sorted_values, query), len(sorted_values) - 1)
+    return sorted_values[at] == query
 
 
 __all__ = ["ExploreFrontiers"]
