@@ -120,11 +120,7 @@ def extract_topology(
     ``ValueError`` for bad inputs.
     """
     grid = _checked_grid(occupancy, origin, voxel_size_m, free)
-    _check_parameters(cell_m, comm_range_m, min_free_voxels, sight_height_m)
-    if open_radius_m is not None and not _positive(open_radius_m):
-        raise ValueError(f"open_radius_m must be a positive finite number or None, got {open_radius_m!r}")
-    if not _positive(max_region_m):
-        raise ValueError(f"max_region_m must be a positive finite number, got {max_region_m!r}")
+    _check_parameters(cell_m, comm_range_m, min_free_voxels, sight_height_m, open_radius_m, max_region_m)
     corner = _checked_point(lattice_origin, "lattice_origin")
     visited_cells = _visited_cells(visited, cell_m, corner)
     standable = _checked_mask(grid, standable, "standable")
@@ -146,19 +142,33 @@ def extract_topology(
     if len(location_keys) == 0:
         return topo
     lattice = _unpack(location_keys, partition)
-    names = [cell_name(c) for c in lattice]
     members = (location_of[component] >= 0) & stands
-    positions = _positions(grid.to_world(ijk[members]), location_of[component[members]],
-                           corner + (lattice + 0.5) * cell_m)
+    world = grid.to_world(ijk[members])
+    positions = world[_position_voxels(world, location_of[component[members]], corner + (lattice + 0.5) * cell_m)]
     explored = ~np.isin(location_keys, _frontier_cell_keys(grid, partition))
     explored |= [tuple(c) in visited_cells for c in lattice.tolist()]
     mobility = _mobility_pairs(_touching_components(labels, partition), location_of)
-    merged: dict[str, str] = {}
+    opened = None
     if open_radius_m is not None:
-        opened = open_faces(labels, partition, open_space(mask | passable_mask, grid.voxel_size_m, open_radius_m))
-        loc = location_of[opened]
-        loc = loc[np.all(loc >= 0, axis=1)]
-        merged = group_cells(names, lattice, loc[np.all(explored[loc], axis=1)], cell_m=cell_m,
+        loc = location_of[open_faces(labels, partition, open_space(mask | passable_mask, grid.voxel_size_m,
+                                                                   open_radius_m))]
+        opened = loc[np.all(loc >= 0, axis=1)]
+    return _network(grid, lattice, positions, explored, mobility, opened, cell_m=cell_m, comm_range_m=comm_range_m,
+                    sight_height_m=sight_height_m, max_region_m=max_region_m, prior=prior, keep=keep)
+
+
+def _network(grid: Grid, lattice: np.ndarray, positions: np.ndarray, explored: np.ndarray, mobility: np.ndarray,
+             opened: np.ndarray | None, *, cell_m: float, comm_range_m: float, sight_height_m: float,
+             max_region_m: float, prior: dict[str, str] | None, keep: tuple[str, ...] | list[str]) -> Topology:
+    """The topology of the locations of lattice cells ``lattice`` (L, 3), in the cells'
+    order, with their ``positions`` (L, 3), ``explored`` flags (L,), ``mobility`` pairs
+    (E, 2) of locations, and ``opened`` pairs of locations open to each other (None:
+    no regions): the regions of the explored open pairs, their edges, and the
+    communication edges by line of sight through ``grid``."""
+    names = [cell_name(c) for c in lattice]
+    merged: dict[str, str] = {}
+    if opened is not None:
+        merged = group_cells(names, lattice, opened[np.all(explored[opened], axis=1)], cell_m=cell_m,
                              max_region_m=max_region_m, prior=prior, keep=keep)
     region = np.array([merged.get(n, n) for n in names])
     names, index = np.unique(region, return_inverse=True)
@@ -166,7 +176,7 @@ def extract_topology(
     explored = np.bincount(index, weights=~explored, minlength=len(names)) == 0
     mobility = _unique_pairs(index[mobility])
     mobility = mobility[mobility[:, 0] != mobility[:, 1]]
-    topo.merged = merged
+    topo = Topology(merged=merged)
     for name, pos, done in zip(names.tolist(), positions, explored):
         topo.add_location(name, pos, explored=bool(done))
     lengths = np.linalg.norm(positions[mobility[:, 0]] - positions[mobility[:, 1]], axis=1)
@@ -226,8 +236,8 @@ def _checked_grid(occupancy: np.ndarray, origin: np.ndarray, voxel_size_m: float
     return Grid(occ, org, float(voxel_size_m), free)
 
 
-def _check_parameters(cell_m: float, comm_range_m: float, min_free_voxels: int,
-                      sight_height_m: float) -> None:
+def _check_parameters(cell_m: float, comm_range_m: float, min_free_voxels: int, sight_height_m: float,
+                      open_radius_m: float | None, max_region_m: float) -> None:
     if not _positive(cell_m):
         raise ValueError(f"cell_m must be a positive finite number, got {cell_m!r}")
     if not _non_negative(comm_range_m):
@@ -237,6 +247,10 @@ def _check_parameters(cell_m: float, comm_range_m: float, min_free_voxels: int,
         raise ValueError(f"min_free_voxels must be a positive integer, got {min_free_voxels!r}")
     if not _non_negative(sight_height_m):
         raise ValueError(f"sight_height_m must be a non-negative finite number, got {sight_height_m!r}")
+    if open_radius_m is not None and not _positive(open_radius_m):
+        raise ValueError(f"open_radius_m must be a positive finite number or None, got {open_radius_m!r}")
+    if not _positive(max_region_m):
+        raise ValueError(f"max_region_m must be a positive finite number, got {max_region_m!r}")
 
 
 def _checked_point(point: np.ndarray | None, what: str) -> np.ndarray:
@@ -293,15 +307,20 @@ def _cropped(grid: Grid) -> tuple[Grid, tuple[slice, ...]]:
     if len(free) == 0:
         return grid, tuple(slice(0, n) for n in grid.shape)
     ijk = np.unravel_index(free, grid.shape)
+    sub, box = _crop(grid, [int(a.min()) for a in ijk], [int(a.max()) for a in ijk])
+    shape = sub.shape
+    sub_free = np.ravel_multi_index(tuple(a - b.start for a, b in zip(ijk, box)), shape)
+    return Grid(sub.occupancy, sub.origin, sub.voxel_size_m, np.sort(sub_free)), box
+
+
+def _crop(grid: Grid, lo: list[int], hi: list[int]) -> tuple[Grid, tuple[slice, ...]]:
+    """The grid cut to the box of voxels ``lo`` to ``hi`` (inclusive, per axis: those of
+    the known-free voxels) widened by the frontier test's margin, and the box."""
     margin = FRONTIER_DEPTH + 1
-    lo = [max(0, int(a.min()) - margin) for a in ijk]
-    hi = [min(n, int(a.max()) + 1 + margin) for a, n in zip(ijk, grid.shape)]
+    lo = [max(0, a - margin) for a in lo]
+    hi = [min(n, b + 1 + margin) for b, n in zip(hi, grid.shape)]
     box = tuple(slice(a, b) for a, b in zip(lo, hi))
-    shape = tuple(b - a for a, b in zip(lo, hi))
-    sub_free = np.ravel_multi_index(tuple(a - o for a, o in zip(ijk, lo)), shape)
-    sub = Grid(grid.occupancy[box], grid.origin + np.array(lo) * grid.voxel_size_m, grid.voxel_size_m,
-               np.sort(sub_free))
-    return sub, box
+    return Grid(grid.occupancy[box], grid.origin + np.array(lo) * grid.voxel_size_m, grid.voxel_size_m), box
 
 
 # -- components and locations ------------------------------------------------------------
@@ -340,16 +359,17 @@ def _locations(component: np.ndarray, cell_key: np.ndarray, stands: np.ndarray,
     return location_of, comp_cell[main]
 
 
-def _positions(world: np.ndarray, location: np.ndarray, centres: np.ndarray) -> np.ndarray:
-    """(L, 3) position of each location: the centre of its voxel (``world``, one row per
-    voxel of ``location``) nearest its cell's centre; ties go to the lowest (x, y, z)."""
+def _position_voxels(world: np.ndarray, location: np.ndarray, centres: np.ndarray) -> np.ndarray:
+    """(L,) per location, the row of ``world`` (voxel centres, one row per voxel of
+    ``location``) that is its position: its voxel nearest its cell's centre; ties go to
+    the lowest (x, y, z)."""
     dist = np.round(np.linalg.norm(world - centres[location], axis=1) / _DISTANCE_ROUNDING_M)
     best = np.full(len(centres), np.inf)
     np.minimum.at(best, location, dist)
     tied = np.flatnonzero(dist == best[location])
     order = tied[np.lexsort((world[tied, 2], world[tied, 1], world[tied, 0], location[tied]))]
     _, first = np.unique(location[order], return_index=True)
-    return world[order[first]]
+    return order[first]
 
 
 def _region_positions(positions: np.ndarray, region: np.ndarray, n: int) -> np.ndarray:

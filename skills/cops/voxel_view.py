@@ -2,8 +2,10 @@
 
 :class:`VoxelNetworkView` implements the robot interface's ``NetworkView`` for any
 robot with an onboard voxel map. The network is extracted from what the robot has
-mapped (:func:`delve.planners.cops.extraction.extract_topology`): locations are the
-cells of a fixed world lattice, so every robot names a place the same way.
+mapped (:func:`delve.planners.cops.extraction.extract_topology`, kept up to date
+from the voxels the map changed by an
+:class:`~delve.planners.cops.extraction_incremental.ExtractionUpdater`): locations are
+the cells of a fixed world lattice, so every robot names a place the same way.
 
 The robot's navigation graph (:mod:`delve.skills.navigation`) says where it can
 stand: a legged robot on the voxels that are nodes of its legged graph (and, when it
@@ -35,17 +37,17 @@ from ...planners.cops.extraction import (
     DEFAULT_COMM_RANGE_M,
     DEFAULT_MIN_FREE_VOXELS,
     cell_name,
-    extract_topology,
     lattice_cells,
     line_of_sight,
 )
+from ...planners.cops.extraction_incremental import ExtractionUpdater
 from ...planners.cops.regions import DEFAULT_MAX_REGION_M, DEFAULT_OPEN_RADIUS_M, cell_of_name
 from ...planners.cops.topology import Topology
 from ...planners.navgraph import NavGraph
 from ...planners.occupancy import FREE, Grid
 from ..base import AgentContext
 from ..navigation import Navigator, Plan
-from ..robot import Robot
+from ..robot import ChangeLog, Robot
 
 #: Flying robots' standable voxels: the free voxels within this many voxels of a node
 #: of the aerial graph (whose nodes lie on a lattice of every second voxel).
@@ -71,7 +73,8 @@ class VoxelNetworkView:
     """The COPS network a robot's onboard map reveals (the ``NetworkView`` protocol).
 
     ``topology()`` is extracted again whenever the navigation graph has been rebuilt
-    (the navigator rebuilds it when the map has changed) since the last call; the
+    (the navigator rebuilds it when the map has changed) since the last call, from the
+    voxels the map changed since the last extraction (the map's change log); the
     cells of the traversed path are marked explored on every call. Pass the agent's shared ``navigator``
     (:func:`delve.skills.navigation.navigator`) to plan on one graph per agent; by
     default the view keeps its own, rebuilt on every map change. Robots of one team
@@ -99,6 +102,12 @@ class VoxelNetworkView:
         self._visited: set[str] = set()
         self._trail_seen = 0
         self.extractions = 0
+        self._extractor = ExtractionUpdater(
+            cell_m=self.cell_m, comm_range_m=self.comm_range_m, min_free_voxels=min_free_voxels,
+            sight_height_m=self.sight_height_m(), lattice_origin=self.lattice_origin,
+            open_radius_m=open_radius_m, max_region_m=max_region_m)
+        #: The map the extractor follows and its change log.
+        self._log: tuple[object, ChangeLog] | None = None
         #: The home's ground point and cell (fixed: a robot's home does not move).
         self._home = self.ground_points(np.asarray(robot.home, dtype=float)[None])[0]
         self._home_cell = self.cell_of(self._home[None])[0]
@@ -226,19 +235,23 @@ class VoxelNetworkView:
         graph = self.navigator.graph()
         if graph is not self._graph:
             grid = self.navigator.grid()
-            self._topology = extract_topology(
-                grid.occupancy, grid.origin, grid.voxel_size_m, standable=self.standable(grid, graph),
-                visited=self._cell_centres(self._visited),
-                passable=grid.occupancy == FREE, free=grid.free, cell_m=self.cell_m,
-                comm_range_m=self.comm_range_m, min_free_voxels=self.min_free_voxels,
-                sight_height_m=self.sight_height_m(), lattice_origin=self.lattice_origin,
-                open_radius_m=self.open_radius_m, max_region_m=self.max_region_m,
-                prior=self._topology.merged, keep=(self.base_cell,))
+            self._topology = self._extractor.update(
+                grid, self._changes(), standable=self.standable(grid, graph),
+                visited=self._cell_centres(self._visited), prior=self._topology.merged, keep=(self.base_cell,))
             self._graph = graph
             self.extractions += 1
         visited = {self._topology.resolve(c) for c in self._visited}
         self._topology.explored |= visited & self._topology.locations.keys()
         return self._topology
+
+    def _changes(self) -> np.ndarray | None:
+        """The voxels the map changed since the last call; None the first time or for a
+        new map object (the extractor then reads the whole map)."""
+        m = self.robot.onboard_map
+        if self._log is None or self._log[0] is not m:
+            self._log = (m, m.change_log())
+            return None
+        return self._log[1].take()
 
     def _cell_centres(self, cells: set[str]) -> np.ndarray:
         """(N, 3) centres of lattice cells given by name."""
@@ -246,10 +259,10 @@ class VoxelNetworkView:
         return self.lattice_origin + (idx + 0.5) * self.cell_m
 
     def standable(self, grid: Grid, graph: NavGraph) -> np.ndarray:
-        """Bool mask of the voxels the robot stands on (legged) or flies through (aerial)."""
+        """Flat indices (ascending) of the free voxels the robot stands on (legged) or
+        flies through (aerial)."""
         mob = self.robot.mobility
         vox = grid.voxel_size_m
-        mask = np.zeros(grid.shape, dtype=bool)
         if mob.aerial:
             nodes = grid.to_index(graph.positions)
             reach = range(-AERIAL_NODE_REACH_VOXELS, AERIAL_NODE_REACH_VOXELS + 1)
@@ -258,11 +271,9 @@ class VoxelNetworkView:
             nodes = grid.to_index(graph.positions - [0.0, 0.0, mob.body_height_m - 0.5 * vox])
             rise = max(1, math.floor(mob.max_step_m / vox + _STEP_TOLERANCE_VOXELS))
             offsets = [(0, 0, c) for c in range(rise)]
-        for d in offsets:
-            idx = nodes + d
-            idx = idx[grid.in_bounds(idx)]
-            mask[idx[:, 0], idx[:, 1], idx[:, 2]] = True
-        return mask & (grid.occupancy == FREE)
+        idx = np.concatenate([nodes + d for d in offsets])
+        flat = np.unique(np.ravel_multi_index(tuple(idx[grid.in_bounds(idx)].T), grid.shape))
+        return flat[grid.occupancy.reshape(-1)[flat] == FREE]
 
     def sight_height_m(self) -> float:
         """How far above a location's position the robot's body (and radio) is."""
