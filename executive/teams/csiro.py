@@ -127,30 +127,85 @@ class Csiro(TeamStrategy):
         return None if agent is None else agent.ctx.services.get(BASE_SERVICE)
 
     def draw(self, ax: Any, mission: "Mission") -> None:
-        """On ``map.png``: each ground robot's topometric map (grey), every robot's frontiers at the
-        end (magenta: their means, as the paper's figures), where syncs happened and the regions
-        robots went back to."""
-        for i, name in enumerate(mission.robots):
-            st = mission.agents[name].ctx.services.get(STATE_SERVICE)
-            if st is None:
-                continue
-            g = st.topometric.graph
-            for a, b in sorted(g.edges):
-                if a[0] != "frontier" and b[0] != "frontier":
-                    pa, pb = g.nodes[a]["pos"], g.nodes[b]["pos"]
-                    ax.plot([pa[0], pb[0]], [pa[1], pb[1]], "-", lw=0.4, color="0.55", zorder=1)
-            means = np.array([f.mean for f in st.frontiers.frontiers]).reshape(-1, 3)
-            if len(means):
-                ax.plot(means[:, 0], means[:, 1], "o", ms=3, color="magenta",
-                        label="frontiers at the end (means)" if i == 0 else None, zorder=4)
-        syncs = np.array([e["position"] for e in mission.state.events if e["event"] == "csiro_sync"]).reshape(-1, 3)
+        """On ``map.png``: the team's topometric map (grey: the trajectory edges; the observer-planning
+        edges, which join nodes across junctions, are counted in the legend, not drawn), the frontiers
+        current at the end (magenta dots at their means; where a mean lies off the world's free space,
+        the mean of a patch of wall or roof, a ground robot's frontier is drawn at its observer and a
+        flying robot's not at all), the goals that failed (red crosses, at the goal), where syncs
+        happened and the regions robots went back to."""
+        states = {name: mission.agents[name].ctx.services.get(STATE_SERVICE) for name in mission.robots}
+        states = {name: st for name, st in states.items() if st is not None}
+        _draw_topometric(ax, [st.topometric for st in states.values()])
+        _draw_frontiers(ax, mission, states)
+        events = mission.state.events
+        failed = np.array(failed_goals(events)).reshape(-1, 3)
+        if len(failed):
+            ax.plot(failed[:, 0], failed[:, 1], "x", ms=4, mew=0.8, color="firebrick", zorder=4,
+                    label=f"frontier goals that failed ({len(failed)})")
+        syncs = np.array([e["position"] for e in events if e["event"] == "csiro_sync"]).reshape(-1, 3)
         if len(syncs):
             ax.plot(syncs[:, 0], syncs[:, 1], "s", ms=6, mfc="none", color="blue", label="explore-sync uplink",
                     zorder=5)
-        regions = np.array([e["region"] for e in mission.state.events
+        regions = np.array([e["region"] for e in events
                             if e["event"] == "csiro_region_reached"]).reshape(-1, 3)
         if len(regions):
             ax.plot(regions[:, 0], regions[:, 1], "*", ms=8, color="orange", label="region returned to", zorder=5)
 
 
-__all__ = ["PARAMS", "Csiro", "Overrides"]
+def failed_goals(events: list[dict[str, Any]]) -> list[list[float]]:
+    """Where each failed goal was: the goal of the robot's ``csiro_goal_selected`` event before its
+    ``csiro_goal_failed``, in the order of the log."""
+    goal: dict[str, list[float]] = {}
+    out = []
+    for e in events:
+        if e["event"] == "csiro_goal_selected":
+            goal[e["agent"]] = e["goal"]
+        elif e["event"] == "csiro_goal_failed" and e.get("agent") in goal:
+            out.append(goal[e["agent"]])
+    return out
+
+
+def _draw_topometric(ax: Any, maps: list[Any]) -> None:
+    """The union of the robots' topometric maps: trajectory edges (a robot's node k to k + 1)."""
+    edges, positions = set(), {}
+    for m in maps:
+        for a, b in m.graph.edges:
+            if a[0] != "frontier" and b[0] != "frontier":
+                edges.add((min(a, b), max(a, b)))
+                positions[a], positions[b] = m.position(a), m.position(b)
+    along = sorted(e for e in edges if e[0][0] == e[1][0] and abs(e[0][1] - e[1][1]) == 1)
+    if not along:
+        return
+    segments = np.array([[positions[a][:2], positions[b][:2]] for a, b in along])
+    xs = np.column_stack([segments[:, :, 0], np.full(len(segments), np.nan)]).reshape(-1)
+    ys = np.column_stack([segments[:, :, 1], np.full(len(segments), np.nan)]).reshape(-1)
+    ax.plot(xs, ys, "-", lw=0.6, color="0.45", zorder=1,
+            label=f"topometric map ({len(edges) - len(along)} observer-planning edges not drawn)")
+
+
+def _draw_frontiers(ax: Any, mission: "Mission", states: dict[str, Any]) -> None:
+    """Every robot's frontiers at the end (see :meth:`Csiro.draw`)."""
+    is_free = getattr(mission.world, "is_free", None)
+    means, observers, hidden = [], [], 0
+    for name, st in states.items():
+        aerial = mission.robots[name].mobility.aerial
+        for f in st.frontiers.frontiers:
+            if is_free is None or bool(is_free(f.mean[None])[0]):
+                means.append(f.mean)
+                continue
+            summary = None if aerial else st.summaries.get((name, f.id))
+            if summary is None:
+                hidden += 1
+            else:
+                observers.append(summary.observer)
+    means, observers = np.array(means).reshape(-1, 3), np.array(observers).reshape(-1, 3)
+    if len(means):
+        ax.plot(means[:, 0], means[:, 1], "o", ms=3, color="magenta", zorder=4,
+                label=f"frontiers at the end, at their means ({len(means)})")
+    if len(observers) or hidden:
+        ax.plot(observers[:, 0], observers[:, 1], "o", ms=4, mfc="none", color="magenta", zorder=4,
+                label=f"frontiers at the end, mean off free space: at their observers ({len(observers)}; "
+                      f"{hidden} without one not drawn)")
+
+
+__all__ = ["PARAMS", "Csiro", "Overrides", "failed_goals"]

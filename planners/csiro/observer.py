@@ -146,31 +146,45 @@ def _candidate_graph(positions: np.ndarray, pairs: np.ndarray) -> nx.Graph:
     return graph
 
 
+#: A sensor that sees every elevation (the paper's spinning, tilted LiDAR, nearly).
+ALL_ELEVATIONS_DEG = (-90.0, 90.0)
+
+
 def observation_rewards(candidates: np.ndarray, frontier: Frontier, d_max_m: float,
-                        params: CsiroSelectionParams) -> np.ndarray:
+                        params: CsiroSelectionParams, *, sensor_height_m: float = 0.0,
+                        elevations_deg: tuple[float, float] = ALL_ELEVATIONS_DEG) -> np.ndarray:
     """(N, K) reward r(a, R) of observing each of the frontier's K triangles from each of N
     candidate positions (equation 12; with ``reduced_dynamic_range``, d_max^3 / r^2 is
-    replaced by d_max^2 / r). The angle is between the triangle's normal (out of the
-    known space) and the view from the candidate through the triangle; triangles beyond
-    d_max or seen from behind give 0."""
-    view = frontier.points[None, :, :] - np.asarray(candidates, float)[:, None, :]
+    replaced by d_max^2 / r). The view is from the sensor, ``sensor_height_m`` above the
+    candidate (a floor point). The angle is between the triangle's normal (out of the
+    known space) and the view from the sensor through the triangle; triangles beyond
+    d_max, seen from behind or outside the sensor's ``elevations_deg`` (min, max) give 0:
+    the paper's "if viewed from agent position a" is a view with the sensor's field."""
+    sensors = np.asarray(candidates, float) + np.array([0.0, 0.0, sensor_height_m])
+    view = frontier.points[None, :, :] - sensors[:, None, :]
     distance = np.linalg.norm(view, axis=2)
     cos_plus = np.maximum(np.einsum("nkj,kj->nk", view, frontier.normals) / np.maximum(distance, 1e-12), 0.0)
+    elevation = np.degrees(np.arctan2(view[:, :, 2], np.linalg.norm(view[:, :, :2], axis=2)))
+    cos_plus[(elevation < elevations_deg[0]) | (elevation > elevations_deg[1])] = 0.0
     r = np.maximum(distance, params.reward_min_range_m)
     reach = d_max_m ** 2 / r if params.reduced_dynamic_range else d_max_m ** 3 / r ** 2
     return frontier.areas[None, :] * cos_plus / 3.0 * np.maximum(reach - r, 0.0)
 
 
 def plan_observer(candidates: ObserverCandidates, frontier: Frontier, d_max_m: float,
-                  params: CsiroSelectionParams) -> Observer | None:
+                  params: CsiroSelectionParams, *, sensor_height_m: float = 0.0,
+                  elevations_deg: tuple[float, float] = ALL_ELEVATIONS_DEG) -> Observer | None:
     """The candidate that observes the most of ``frontier`` and its total reward
-    (equation 13; the first of equals), or None when there is no candidate."""
+    (equation 13, with the sensor of :func:`observation_rewards`; the first of equals), or
+    None when there is no candidate. A reward of 0 means that no candidate sees any of the
+    frontier's triangles: no useful frontier for this robot."""
     if len(candidates) == 0:
         return None
-    total = observation_rewards(candidates.positions, frontier, d_max_m, params).sum(axis=1)
+    total = observation_rewards(candidates.positions, frontier, d_max_m, params,
+                                sensor_height_m=sensor_height_m, elevations_deg=elevations_deg).sum(axis=1)
     best = int(np.argmax(total))
     return Observer(position=candidates.positions[best].copy(), reward=float(total[best]), index=best)
 
 
-__all__ = ["Observer", "ObserverCandidates", "observation_rewards", "observer_candidates", "plan_observer",
-           "surface_normals", "traversable_vertices"]
+__all__ = ["ALL_ELEVATIONS_DEG", "Observer", "ObserverCandidates", "observation_rewards",
+           "observer_candidates", "plan_observer", "surface_normals", "traversable_vertices"]

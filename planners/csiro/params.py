@@ -14,7 +14,10 @@ class CsiroFrontierParams:
     eta_area 0.2 m^2, d_min 1 m, T_min 0.5 s, d_vp 5 m, eta_vis 5 mm. The paper gives no value for
     eta_dia (the largest distance of a segment's triangle from its anchor); 4 m keeps the segment
     at the open end of a 5 m wide drift in one piece. The sensor's elevations default to a fixed
-    Velodyne Puck's +-15 deg; a skill sets them from the robot's LiDAR. ``assignment_max_kl`` bounds
+    Velodyne Puck's +-15 deg; a skill sets them from the robot's LiDAR. ``blind_frontiers`` (not in
+    the paper, whose sensor sees nearly every elevation): whether the sphere points a robot sees
+    in the cones its sensor is blind to are frontier points too; a skill sets it for a flying robot,
+    which can rise or sink to see them (a shaft straight above). ``assignment_max_kl`` bounds
     the KL divergence of an old/new correspondence (not in the paper, which assigns every pair the
     assignment picks: infinity).
     """
@@ -32,6 +35,7 @@ class CsiroFrontierParams:
     eta_vis_m: float = 0.005
     elevation_min_deg: float = -15.0
     elevation_max_deg: float = 15.0
+    blind_frontiers: bool = False
     assignment_max_kl: float = math.inf
 
     def __post_init__(self) -> None:
@@ -55,6 +59,8 @@ def check_frontier_params(p: CsiroFrontierParams) -> None:
     """Raise ValueError naming the first parameter out of range (gamma must be negative, distances
     positive, elevations within [-90, 90] deg and min below max, eta_subsample at most d_max)."""
     values = {f.name: getattr(p, f.name) for f in fields(p)}
+    if not isinstance(values.pop("blind_frontiers"), bool):
+        raise ValueError(f"blind_frontiers must be true or false, got {p.blind_frontiers!r}")
     for name, v in values.items():
         if not isinstance(v, (int, float)) or isinstance(v, bool) or math.isnan(v):
             raise ValueError(f"{name} must be a number, got {v!r}")

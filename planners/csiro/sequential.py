@@ -29,7 +29,7 @@ from scipy.spatial import cKDTree
 from .frontier_types import Frontier, FrontierMesh
 from .params import CsiroFrontierParams
 from .segmentation import grow_regions, make_frontier, segment_frontiers
-from .visibility_mesh import visible_mesh
+from .visibility_mesh import SURFACE_VOXELS, visible_mesh
 
 
 @dataclass(frozen=True)
@@ -71,7 +71,9 @@ def mesh_scene(mesh: FrontierMesh) -> o3d.t.geometry.RaycastingScene:
 def seen_from(points: np.ndarray, mesh: FrontierMesh, scene: o3d.t.geometry.RaycastingScene,
               params: CsiroFrontierParams) -> np.ndarray:
     """Vis(p) of equation 9 for each of ``points`` (K, 3): within d_max of the mesh's viewpoint and at
-    least eta_vis in front of the first triangle that the ray from the viewpoint through p meets."""
+    least eta_vis in front of the first triangle that the ray from the viewpoint through p meets (a ray
+    that meets none, out through the mesh's hole over the sensor's blind cones, has no surface in
+    front of p: seen)."""
     d = np.asarray(points, float) - mesh.viewpoint
     r = np.linalg.norm(d, axis=1)
     test = np.flatnonzero((r > 0) & (r <= params.d_max_m))
@@ -81,6 +83,23 @@ def seen_from(points: np.ndarray, mesh: FrontierMesh, scene: o3d.t.geometry.Rayc
     rays = np.concatenate([np.zeros((len(test), 3)), d[test] / r[test, None]], axis=1).astype(np.float32)
     t_hit = scene.cast_rays(o3d.core.Tensor(rays))["t_hit"].numpy()
     out[test] = t_hit >= r[test] + params.eta_vis_m
+    return out
+
+
+def on_surface(points: np.ndarray, surface: cKDTree, agent: np.ndarray,
+               params: CsiroFrontierParams) -> np.ndarray:
+    """(K,) bool: frontier ``points`` within d_max of ``agent`` that now lie on observed surface,
+    within a voxel's diagonal of a point of ``surface`` (the kd-tree of the cloud). Not in the
+    paper: the middle of a long edge lies on the surface it spanned (a floor seen in rings far
+    apart), and once the gap is filled the ray test of equation 9 finds it as often behind the
+    surface as in front; the same rule keeps such middles from being frontier points in the first
+    place (:func:`.visibility_mesh.split_long_edges`)."""
+    points = np.asarray(points, float)
+    near = np.linalg.norm(points - agent, axis=1) <= params.d_max_m
+    out = np.zeros(len(points), dtype=bool)
+    if near.any() and surface.n:
+        gap, _ = surface.query(points[near], distance_upper_bound=SURFACE_VOXELS * params.d_vox_m)
+        out[near] = np.isfinite(gap)
     return out
 
 
@@ -154,7 +173,9 @@ class SequentialFrontiers:
         changed_old: list[Frontier] = []       # the old frontiers as they were (for the assignment)
         changed_rest: list[Frontier] = []      # what is left of them (for the clustering)
         old = [self._frontiers[k] for k in sorted(self._frontiers)]
+        surface = cKDTree(np.asarray(cloud, float).reshape(-1, 3))
         for f, seen in zip(old, self._seen(old, mesh, scene)):
+            seen = seen | on_surface(f.points, surface, a, p)
             if not seen.any():
                 continue
             changed_old.append(f)
@@ -179,6 +200,12 @@ class SequentialFrontiers:
         for k in [k for k in self._scenes if np.linalg.norm(self._viewpoints[k].position - a) > 2 * p.d_max_m]:
             del self._scenes[k]          # out of reach: the memory back; rebuilt if the agent returns
         return FrontierUpdate(self.frontiers, mesh, None, created, removed, kept)
+
+    def discard(self, ids: list[int]) -> None:
+        """Forget the frontiers ``ids`` (no observer can see them: no useful frontier, Section
+        III-C)."""
+        for fid in ids:
+            self._frontiers.pop(fid, None)
 
     def _scene(self, k: int) -> o3d.t.geometry.RaycastingScene:
         if k not in self._scenes:
@@ -248,4 +275,5 @@ class SequentialFrontiers:
         return ids
 
 
-__all__ = ["FrontierUpdate", "SequentialFrontiers", "Viewpoint", "gaussian_kl", "mesh_scene", "seen_from"]
+__all__ = ["FrontierUpdate", "SequentialFrontiers", "Viewpoint", "gaussian_kl", "mesh_scene", "on_surface",
+           "seen_from"]

@@ -77,6 +77,11 @@ class TrajectoryPoints:
         self._last_s = t_s
         return True
 
+    def visit(self, position: np.ndarray) -> None:
+        """Keep ``position`` now, whatever the period: a place the robot went to on purpose
+        (a teammate's frontier's observer), so that equation 14 discounts what lies there."""
+        self._points.append(np.asarray(position, float).copy())
+
     def __len__(self) -> int:
         return len(self._points)
 

@@ -6,6 +6,15 @@ exponential inversion (equation 3); the convex hull of the transformed points an
 what the agent sees. Visible sphere points are frontier points (equation 6); edges longer than
 eta_disc are split at their middle, which becomes a discontinuity frontier point (equations 7-8),
 unless that middle lies within a voxel's diagonal of an observed point (see :func:`split_long_edges`).
+
+Where delve departs from the paper: the sphere points are limited to the sensor's elevations, as the
+paper says, but a sensor that sees a narrow band (a legged robot's +-15 deg) leaves the hull open
+over the blind cones above and below, and every point at the rim of that opening lies on the hull:
+sphere points behind the walls and the middles of long edges from them to the walls' tops became
+frontiers outside the drift, never to be seen again. Sphere points in the blind cones
+(:func:`blind_sphere_points`) close the hull; they are no frontier points, and the triangles that
+touch one are dropped from the mesh (the sensor sees nothing there), unless ``blind_frontiers``
+(a flying robot) makes the visible ones frontier points like the others.
 scipy's ConvexHull is used rather than open3d's hidden_point_removal, which hard-codes the
 spherical-flipping kernel, not the paper's exponential one.
 """
@@ -24,12 +33,11 @@ MIN_POINTS = 4
 SURFACE_VOXELS = np.sqrt(3.0)
 
 
-def sphere_points(agent: np.ndarray, params: CsiroFrontierParams) -> np.ndarray:
-    """S(a, d_max): points on the sphere of radius d_max around ``agent``, about eta_disc / 2
-    apart, at the elevations the sensor sees (elevation_min_deg..elevation_max_deg).
-    Returns (M, 3), rows by elevation then azimuth."""
+def _sphere_rows(agent: np.ndarray, params: CsiroFrontierParams, lo_deg: float, hi_deg: float) -> np.ndarray:
+    """Points on the sphere of radius d_max around ``agent`` between elevations ``lo_deg`` and
+    ``hi_deg`` (both rows included), about eta_disc / 2 apart; rows by elevation then azimuth."""
     step = params.sphere_spacing_rad
-    lo, hi = np.radians(params.elevation_min_deg), np.radians(params.elevation_max_deg)
+    lo, hi = np.radians(lo_deg), np.radians(hi_deg)
     rows = max(int(np.ceil((hi - lo) / step)), 1)
     out = []
     for el in np.linspace(lo, hi, rows + 1):
@@ -37,6 +45,27 @@ def sphere_points(agent: np.ndarray, params: CsiroFrontierParams) -> np.ndarray:
         az = np.arange(n) * (2 * np.pi / n)
         out.append(np.stack([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.full(n, np.sin(el))], axis=1))
     return np.asarray(agent, float) + params.d_max_m * np.concatenate(out)
+
+
+def sphere_points(agent: np.ndarray, params: CsiroFrontierParams) -> np.ndarray:
+    """S(a, d_max): points on the sphere of radius d_max around ``agent``, about eta_disc / 2
+    apart, at the elevations the sensor sees (elevation_min_deg..elevation_max_deg).
+    Returns (M, 3), rows by elevation then azimuth."""
+    return _sphere_rows(agent, params, params.elevation_min_deg, params.elevation_max_deg)
+
+
+def blind_sphere_points(agent: np.ndarray, params: CsiroFrontierParams) -> np.ndarray:
+    """Points on the same sphere in the cones the sensor does not see (above elevation_max_deg,
+    below elevation_min_deg; none for a sensor that sees every elevation), as far apart as
+    those of :func:`sphere_points`, the rows nearest the sensor's view one step outside it.
+    They close the hull over the blind cones (see :func:`visible_mesh`). Returns (M, 3)."""
+    step = np.degrees(params.sphere_spacing_rad)
+    parts = [np.zeros((0, 3))]
+    if params.elevation_max_deg + step < 90.0:
+        parts.append(_sphere_rows(agent, params, params.elevation_max_deg + step, 90.0))
+    if params.elevation_min_deg - step > -90.0:
+        parts.append(_sphere_rows(agent, params, -90.0, params.elevation_min_deg - step))
+    return np.concatenate(parts)
 
 
 def exponential_inversion(points: np.ndarray, agent: np.ndarray, gamma: float) -> np.ndarray:
@@ -47,19 +76,20 @@ def exponential_inversion(points: np.ndarray, agent: np.ndarray, gamma: float) -
     return d * (r ** (gamma - 1.0))[:, None]
 
 
-def behind_observed(sphere: np.ndarray, cloud: np.ndarray, agent: np.ndarray, d_vox_m: float) -> np.ndarray:
-    """(M,) bool: sphere points straight behind an observed point, within half a voxel's angular
-    footprint (d_vox / 2 / range) of the direction of the cloud point nearest in direction. They
-    are hidden (give or take half a voxel at the rim of an opening), so leaving them out of the
-    hull changes little but its cost: in a drift most of the sphere is behind the walls, and qhull
-    takes about a third less time without it."""
+def behind_observed(sphere: np.ndarray, cloud: np.ndarray, agent: np.ndarray, width_m: float) -> np.ndarray:
+    """(M,) bool: sphere points straight behind an observed point, within the angle that half of
+    ``width_m`` subtends at the range of the cloud point nearest in direction. With the width of a
+    voxel they are hidden (give or take half a voxel at the rim of an opening), so leaving them out
+    of the hull changes little but its cost: in a drift most of the sphere is behind the walls, and
+    qhull takes about a third less time without it. With eta_disc, gaps narrower than a
+    discontinuity in the observed surface count as closed."""
     d = cloud - agent
     r = np.linalg.norm(d, axis=1)
     u = (sphere - agent) / np.linalg.norm(sphere - agent, axis=1)[:, None]
-    gap, near = cKDTree(d / r[:, None]).query(u, distance_upper_bound=0.5 * d_vox_m / r.min())
+    gap, near = cKDTree(d / r[:, None]).query(u, distance_upper_bound=0.5 * width_m / r.min())
     hit = np.isfinite(gap)
     out = np.zeros(len(sphere), dtype=bool)
-    out[hit] = gap[hit] <= 0.5 * d_vox_m / r[near[hit]]
+    out[hit] = gap[hit] <= 0.5 * width_m / r[near[hit]]
     return out
 
 
@@ -138,15 +168,21 @@ def visible_mesh(cloud: np.ndarray, agent: np.ndarray,
         return None, f"too few points in range: {len(cloud)} within {params.d_max_m} m (need {MIN_POINTS})"
     if np.linalg.matrix_rank(cloud - cloud.mean(axis=0)) < 3:
         return None, f"degenerate point cloud: the {len(cloud)} points in range lie on one plane"
+    # the sensor looked along the sphere points of its view; in its blind cones only a gap in the
+    # cached surface wider than a discontinuity (eta_disc) is an opening
     sphere = sphere_points(a, params)
     sphere = sphere[~behind_observed(sphere, cloud, a, params.d_vox_m)]
-    points = np.concatenate([cloud, sphere])
+    blind = blind_sphere_points(a, params)
+    blind = blind[~behind_observed(blind, cloud, a, params.eta_disc_m)]
+    points = np.concatenate([cloud, sphere, blind])
     transformed = np.concatenate([exponential_inversion(points, a, params.gamma), np.zeros((1, 3))])
     try:
         hull = ConvexHull(transformed)
     except QhullError as err:     # a cloud that defeats qhull is a degenerate view, not an error
         return None, f"degenerate point cloud: qhull failed ({str(err).splitlines()[0]})"
-    tri = hull.simplices[~np.any(hull.simplices == len(points), axis=1)]   # drop faces at the viewpoint
+    # drop the faces at the viewpoint, and those over the sensor's blind cones unless they are frontier
+    seen = len(points) if params.blind_frontiers else len(cloud) + len(sphere)
+    tri = hull.simplices[~np.any(hull.simplices >= seen, axis=1)]
     used, tri = np.unique(tri, return_inverse=True)
     tri = tri.reshape(-1, 3).astype(np.int64)
     vertices = points[used]
@@ -183,5 +219,5 @@ def triangle_geometry(mesh: FrontierMesh) -> tuple[np.ndarray, np.ndarray, np.nd
     return centroids, n, 0.5 * twice_area
 
 
-__all__ = ["MIN_POINTS", "behind_observed", "exponential_inversion", "sphere_points", "split_long_edges", "triangle_geometry",
-           "visible_mesh"]
+__all__ = ["MIN_POINTS", "behind_observed", "blind_sphere_points", "exponential_inversion", "sphere_points",
+           "split_long_edges", "triangle_geometry", "visible_mesh"]

@@ -17,10 +17,13 @@ from ..navigation import navigator
 from .state import CsiroState, csiro_state
 
 
-def reachable_near(ctx: Any, robot: Any, point: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+def reachable_near(ctx: Any, robot: Any, point: np.ndarray,
+                   fresh: bool = False) -> tuple[np.ndarray, np.ndarray] | None:
     """The path to the node of the robot's navigation graph that it can reach and that lies
-    nearest ``point``, and that node's position; None when the robot is off its graph."""
-    plan = navigator(ctx, robot).from_robot()
+    nearest ``point``, and that node's position; None when the robot is off its graph. With
+    ``fresh`` the graph is rebuilt first if the map changed since it was built."""
+    nav = navigator(ctx, robot)
+    plan = nav.from_robot(force=fresh and nav.map_changed())
     if plan is None:
         return None
     reach = np.flatnonzero(np.isfinite(plan.distances))
@@ -37,15 +40,19 @@ class FollowFrontierGoal(GoTo):
     A ground robot's first path is the topometric map's A* path to the frontier (other robots'
     trajectories cross space its own map lacks), re-planned like ``GoTo`` when blocked. Progress
     is watched as Algorithm 3 says: when the closest approach to the goal improves by less than
-    ``progress_m`` in ``progress_window_s`` (1 m, 15 s), or the way cannot be planned, or the
-    frontier is still unchanged ``dwell_s`` after the robot reached the goal, the goal has
-    failed: a ground robot's frontier gets the penalty rho_fail until it is updated and its
-    observer joins the failed goals of L; a flying robot blacklists it.
+    ``progress_m`` in ``progress_window_s`` (1 m, 15 s), or the way cannot be planned (on the
+    navigation graph rebuilt from the current map), or the robot's own frontier is still
+    unchanged ``dwell_s`` after it reached the goal, the goal has failed: a ground robot's
+    frontier gets the penalty rho_fail until it is updated and its observer joins the failed
+    goals of L; a flying robot blacklists it.
 
     Reads ``goal`` and ``csiro_goal``. Returns SUCCESS when the frontier is gone (explored), its
-    observer moved more than ``reselect_m`` from the goal (select again), or (flying robot) it
-    came within eta_blacklist of its centre (complete, and blacklisted); RUNNING on the way and
-    while standing at the goal; FAILURE when the goal failed (``csiro_goal_failed`` in the log).
+    observer moved more than ``reselect_m`` from the goal, it changed while the robot stood at
+    the goal (select again), a teammate's frontier's observer was reached (only its owner can
+    update it; the place joins the robot's trajectory points, which discount it, equation 14),
+    or (flying robot) it came within eta_blacklist of its centre (complete, and blacklisted);
+    RUNNING on the way and while standing at the goal; FAILURE when the goal failed
+    (``csiro_goal_failed`` in the log).
     """
 
     PARAMS = {**{k: v for k, v in GoTo.PARAMS.items() if k != "goal"},
@@ -62,10 +69,11 @@ class FollowFrontierGoal(GoTo):
         self.watch: GoalProgress | None = None
         self.watch_key: tuple[str, int] | None = None
         self.arrived_s: float | None = None
+        self.arrived_version: float | None = None  # the frontier's updated_s on arrival
 
     def initialise(self) -> None:
         super().initialise()
-        self.arrived_s = None
+        self.arrived_s = self.arrived_version = None
         key = self.read("csiro_goal")
         self.key = None if key is None else (str(key[0]), int(key[1]))
         st = csiro_state(self.ctx)
@@ -84,27 +92,61 @@ class FollowFrontierGoal(GoTo):
                 self.watch.goal = self.goal
         done = self._frontier_done(st)
         if done:
-            self.stop_own_motion()
-            self.moving = False
-            self.event("csiro_goal_done", key=list(self.key), why=done)
-            return Status.SUCCESS
+            return self._done(done)
         if self.watch.update(self.ctx.clock.now_s, r.position):
             return self._failed(st, f"closest approach improved less than {self.watch.progress_m:g} m in "
                                     f"{self.watch.window_s:g} s")
         if self.goal is not None and self.reached():
-            self.stop_own_motion()
-            self.moving = False
-            now = self.ctx.clock.now_s
-            self.arrived_s = now if self.arrived_s is None else self.arrived_s
-            if now - self.arrived_s >= self.p["dwell_s"]:
-                return self._failed(st, f"still a frontier {self.p['dwell_s']:g} s after reaching its observer")
-            self.feedback_message = "at the goal, waiting for the frontier to change"
-            return Status.RUNNING
+            return self._at_goal(st)
         self.arrived_s = None
         status = super().update()
         if status == Status.FAILURE:
             return self._failed(st, self.feedback_message)
         return Status.RUNNING if status == Status.SUCCESS else status
+
+    def _at_goal(self, st: CsiroState) -> Status:
+        """Standing at the goal: done when it is a teammate's frontier or the frontier changed,
+        on to a nearer place (flying robot, on arrival), failed after ``dwell_s`` unchanged, else
+        RUNNING."""
+        self.stop_own_motion()
+        self.moving = False
+        now, r = self.ctx.clock.now_s, self.robot
+        if not r.mobility.aerial and self.key[0] != self.ctx.name:
+            st.trajectory.visit(r.position)
+            return self._done("reached a teammate's frontier")
+        summary = st.summaries.get(self.key)
+        version = None if summary is None else summary.updated_s
+        if self.arrived_s is None:
+            if r.mobility.aerial and self._nearer_place(st):
+                status = self.plan()
+                return self._failed(st, self.feedback_message) if status == Status.FAILURE else Status.RUNNING
+            self.arrived_s, self.arrived_version = now, version
+        if version != self.arrived_version:
+            return self._done("changed")
+        if now - self.arrived_s >= self.p["dwell_s"]:
+            return self._failed(st, f"still a frontier {self.p['dwell_s']:g} s after reaching its observer")
+        self.feedback_message = "at the goal, waiting for the frontier to change"
+        return Status.RUNNING
+
+    def _nearer_place(self, st: CsiroState) -> bool:
+        """A flying robot at its goal short of the frontier's centre: whether the navigation
+        graph, rebuilt from the current map, reaches at least ``progress_m`` nearer the centre
+        (the goal was chosen on a graph up to ``rebuild_period_s`` old); if so it is the new
+        goal, watched afresh."""
+        frontier = next((f for f in st.frontiers.frontiers if f.id == self.key[1]), None)
+        near = None if frontier is None else reachable_near(self.ctx, self.robot, frontier.mean, fresh=True)
+        if near is None or (np.linalg.norm(near[1] - frontier.mean) + st.selection.progress_m
+                            > np.linalg.norm(self.robot.position - frontier.mean)):
+            return False
+        self.goal, self.last_end = near[1], None
+        self.watch = GoalProgress(self.goal, st.selection)
+        return True
+
+    def _done(self, why: str) -> Status:
+        self.stop_own_motion()
+        self.moving = False
+        self.event("csiro_goal_done", key=list(self.key), why=why)
+        return Status.SUCCESS
 
     def _frontier_done(self, st: CsiroState) -> str:
         """Why the goal is over ('' while it is not)."""
@@ -148,6 +190,10 @@ class FollowFrontierGoal(GoTo):
             if path is not None and len(path.points) > 2:
                 return path.points[1:-1], "topometric", "", ""   # the goal is appended by GoTo
         path, source, code, why = super()._path(grid)
+        nav = navigator(self.ctx, r)
+        if path is None and code == "no_path" and self.replans == 0 and nav.map_changed():
+            nav.graph(force=True)   # the graph may be rebuild_period_s old: the observer lies beyond it
+            path, source, code, why = super()._path(grid)
         if path is None and code == "no_path":
             near = reachable_near(self.ctx, r, self.goal)
             if near is not None and (np.linalg.norm(near[1] - self.goal) + st.selection.progress_m

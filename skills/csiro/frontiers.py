@@ -27,12 +27,14 @@ class UpdateFrontiers(Skill):
     (every 5 s). When a sweep came and the frontier update is due (d_min of motion, T_min apart;
     or the last update saw too little) the frontiers of Algorithm 2 are updated from the
     cache's cloud seen from the LiDAR; a ground robot plans the observer of every new or changed
-    frontier on the current mesh (equation 13), hangs it off the topometric map and joins its
-    current node to the trajectory nodes the mesh reaches. A degenerate cloud is no error:
-    nothing changes, ``csiro_no_view`` says why (once per cause).
+    frontier on the current mesh (equation 13, seen with its LiDAR's elevations), hangs it off
+    the topometric map and joins its current node to the trajectory nodes the mesh reaches; a
+    frontier that no candidate's LiDAR sees (a patch of roof above the reachable floor) is no
+    useful frontier and is dropped. A degenerate cloud is no error: nothing changes,
+    ``csiro_no_view`` says why (once per cause).
 
     Writes ``csiro_frontier_count`` (the robot's own frontiers). Logs ``csiro_frontiers`` when
-    frontiers appear or go. Returns RUNNING.
+    frontiers appear or go, ``csiro_frontiers_unobservable`` when some are dropped. Returns RUNNING.
     """
 
     PARAMS = {
@@ -89,12 +91,23 @@ class UpdateFrontiers(Skill):
         node = st.topometric.last_node(name)
         if node is not None and len(candidates):
             st.topometric.connect_reachable(node, candidates.positions + lift, self.p["link_radius_m"])
+        unseen = []
         for f in changed:
-            observer = plan_observer(candidates, f, fp.d_max_m, st.selection)
+            observer = plan_observer(candidates, f, fp.d_max_m, st.selection, sensor_height_m=float(lift[2]),
+                                     elevations_deg=(fp.elevation_min_deg, fp.elevation_max_deg))
             if observer is None:
                 continue  # no place to observe it from here: the old observer stays
+            if observer.reward <= 0.0:
+                unseen.append(f.id)  # no candidate's sensor sees any of it: no useful frontier
+                continue
             summary = st.summaries[(name, f.id)] = summarise(f, name, observer, now)
             st.topometric.attach_frontier(summary.key, name, now, summary.observer + lift)
+        if unseen:
+            st.frontiers.discard(unseen)
+            for fid in unseen:
+                st.summaries.pop((name, fid), None)
+                st.topometric.detach_frontier((name, fid))
+            self.event("csiro_frontiers_unobservable", ids=unseen, count=len(st.frontiers.frontiers))
 
 
 __all__ = ["UpdateFrontiers", "body_lift"]

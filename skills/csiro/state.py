@@ -88,13 +88,17 @@ class CsiroState:
 
 def csiro_state(ctx: AgentContext, view_up_deg: float | None = None) -> CsiroState:
     """The agent's :class:`CsiroState`, created on first use; the sensor's elevations of the
-    frontier parameters are set to +-``view_up_deg`` (the robot's LiDAR) when given."""
+    frontier parameters are set to +-``view_up_deg`` (the robot's LiDAR) when given, and a flying
+    robot's blind cones hold frontiers (``blind_frontiers``: it can rise or sink to see them)."""
     state = ctx.services.get(STATE_SERVICE)
     if state is None:
         cfg = csiro_config(ctx)
         fp = cfg.frontier
         if view_up_deg is not None and 0.0 < view_up_deg <= 90.0:
             fp = replace(fp, elevation_min_deg=-view_up_deg, elevation_max_deg=view_up_deg)
+        robot = getattr(ctx, "robot", None)
+        if robot is not None and robot.mobility.aerial:
+            fp = replace(fp, blind_frontiers=True)
         state = ctx.services[STATE_SERVICE] = CsiroState(
             frontier_params=fp, selection=cfg.selection, cache=PointCache(fp.d_vox_m),
             frontiers=SequentialFrontiers(fp), topometric=TopometricMap(cfg.topometric_spacing_m),

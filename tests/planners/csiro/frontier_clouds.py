@@ -55,3 +55,12 @@ def room_with_doorway(open_door: bool = True) -> np.ndarray:
     second = box((3, -3, -1), (7, 3, 2))
     second = second[second[:, 0] > 3.0 + 1e-9]       # the shared wall belongs to the first room
     return np.concatenate([first, second])
+
+
+def banded_scan(surface: np.ndarray, sensor, band_deg: float = 15.0, range_m: float = 30.0) -> np.ndarray:
+    """The points of ``surface`` a LiDAR at ``sensor`` returns when it sees only elevations within
+    +-``band_deg`` (a legged robot's Velodyne Puck); a convex drift, so no point hides another."""
+    d = surface - np.asarray(sensor, float)
+    r = np.linalg.norm(d, axis=1)
+    elevation = np.degrees(np.arcsin(d[:, 2] / r))
+    return surface[(np.abs(elevation) <= band_deg) & (r <= range_m)]

@@ -132,6 +132,26 @@ def test_reward_favours_observers_facing_the_frontier():
     assert r[2] == pytest.approx(0.0) and r[3] == 0.0
 
 
+def test_a_triangle_outside_the_sensors_elevations_gives_no_reward():
+    roof = one_triangle_frontier([0.0, 0.0, 3.0], [0.0, 0.0, 1.0])          # straight above, facing up
+    floor = np.array([[x, 0.0, 0.0] for x in np.arange(-8.0, 8.1, 1.0)])
+    seen = observation_rewards(floor, roof, D_MAX, P, sensor_height_m=0.5)
+    assert seen.max() > 0                                                   # a sensor seeing every elevation
+    band = observation_rewards(floor, roof, D_MAX, P, sensor_height_m=0.5, elevations_deg=(-15.0, 15.0))
+    assert np.all(band == 0.0)                                              # 2.5 m up needs 9.3 m away
+    wall = one_triangle_frontier([5.0, 0.0, 1.0], [1.0, 0.0, 0.0])
+    band = observation_rewards(floor, wall, D_MAX, P, sensor_height_m=0.5, elevations_deg=(-15.0, 15.0))
+    assert band.max() > 0
+
+
+def test_a_frontier_no_candidate_sees_has_an_observer_of_no_reward():
+    cand = observer_candidates(grid_mesh(AXIS, AXIS), np.array([0.0, 0.0, 0.5]), P)
+    roof = one_triangle_frontier([1.0, 0.0, 3.0], [0.0, 0.0, 1.0])
+    assert plan_observer(cand, roof, D_MAX, P, sensor_height_m=0.5).reward > 0
+    band = plan_observer(cand, roof, D_MAX, P, sensor_height_m=0.5, elevations_deg=(-15.0, 15.0))
+    assert band.reward == 0.0
+
+
 def test_observer_is_the_candidate_observing_most():
     mesh = grid_mesh(AXIS, AXIS)
     cand = observer_candidates(mesh, np.array([0.0, 0.0, 0.5]), P)

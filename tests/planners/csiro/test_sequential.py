@@ -5,7 +5,9 @@ import numpy as np
 from delve.planners.csiro.frontier_types import FrontierMesh
 from delve.planners.csiro.params import CsiroFrontierParams
 from delve.planners.csiro.point_cache import PointCache
-from delve.planners.csiro.sequential import SequentialFrontiers, gaussian_kl, mesh_scene, seen_from
+from delve.planners.csiro.sequential import (SequentialFrontiers, gaussian_kl, mesh_scene, on_surface,
+                                             seen_from)
+from scipy.spatial import cKDTree
 
 from .frontier_clouds import corridor, rectangle
 
@@ -35,6 +37,21 @@ def test_a_frontier_seen_from_a_later_viewpoint_disappears():
     assert not any(f.mean[0] > 0 for f in later.frontiers)            # from x = 6 its end wall is seen
     assert set(later.removed_ids) >= {f.id for f in first.frontiers if f.mean[0] > 7.5}
     assert len(later.frontiers) >= 1 and all(f.mean[0] < -7.5 for f in later.frontiers)
+
+
+def test_discarded_frontiers_are_forgotten():
+    seq, (first,) = drive(corridor(-40, 40), [0])
+    ids = [f.id for f in first.frontiers]
+    seq.discard(ids[:1] + [999])
+    assert [f.id for f in seq.frontiers] == ids[1:]
+
+
+def test_a_frontier_point_on_surface_observed_since_is_seen():
+    floor = rectangle((-5, -5, 0), (10, 0, 0), (0, 10, 0))
+    points = np.array([[1.0, 0.0, -0.05], [1.0, 0.0, 1.5], [20.0, 0.0, 0.0]])   # on, above, out of range
+    agent = np.array([0.0, 0.0, 1.0])
+    assert on_surface(points, cKDTree(floor), agent, P).tolist() == [True, False, False]
+    assert not on_surface(points, cKDTree(np.zeros((0, 3))), agent, P).any()
 
 
 def test_the_kl_assignment_keeps_the_ids_of_the_frontiers_being_followed():

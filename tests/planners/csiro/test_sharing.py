@@ -53,6 +53,14 @@ def test_trajectory_keeps_a_point_every_period():
     assert len(trail) == 3
 
 
+def test_a_visited_place_is_kept_whatever_the_period():
+    trail = TrajectoryPoints(P)
+    trail.add(0.0, np.zeros(3))
+    trail.visit(np.array([2.0, 0.0, 0.0]))
+    assert not trail.add(1.0, np.ones(3))                      # the period still counts from t = 0
+    assert np.array_equal(trail.points(), [[0.0, 0.0, 0.0], [2.0, 0.0, 0.0]])
+
+
 def test_summary_round_trips_through_a_message():
     frontier = Frontier(id=7, points=np.zeros((1, 3)), normals=np.array([[1.0, 0, 0]]), areas=np.ones(1),
                         mean=np.array([1.0, 2.0, 3.0]), cov=np.eye(3))

@@ -5,10 +5,12 @@ from scipy.spatial import cKDTree
 
 from delve.planners.csiro.params import CsiroFrontierParams
 from delve.planners.csiro.point_cache import PointCache
-from delve.planners.csiro.visibility_mesh import (behind_observed, exponential_inversion, sphere_points, split_long_edges,
-                                                  triangle_geometry, visible_mesh)
+from delve.planners.csiro.sequential import SequentialFrontiers
+from delve.planners.csiro.visibility_mesh import (behind_observed, blind_sphere_points, exponential_inversion,
+                                                  sphere_points, split_long_edges, triangle_geometry,
+                                                  visible_mesh)
 
-from .frontier_clouds import corridor, rectangle, room_with_doorway
+from .frontier_clouds import banded_scan, box, corridor, rectangle, room_with_doorway
 
 P = CsiroFrontierParams()
 AGENT = np.array([0.0, 0.0, 1.0])
@@ -38,6 +40,53 @@ def test_sphere_points_lie_on_d_max_within_the_sensors_elevations_half_eta_disc_
     assert el.min() >= P.elevation_min_deg - 1e-9 and el.max() <= P.elevation_max_deg + 1e-9
     gap, _ = cKDTree(s).query(s, k=2)
     assert gap[:, 1].max() <= 0.5 * P.eta_disc_m * 1.01
+
+
+def test_blind_sphere_points_fill_the_elevations_the_sensor_does_not_see():
+    s = blind_sphere_points(AGENT, P) - AGENT
+    np.testing.assert_allclose(np.linalg.norm(s, axis=1), P.d_max_m)
+    el = np.degrees(np.arcsin(np.clip(s[:, 2] / P.d_max_m, -1, 1)))
+    assert np.all((el > P.elevation_max_deg) | (el < P.elevation_min_deg))
+    assert el.max() == 90.0 and el.min() == -90.0
+    everywhere = dataclasses.replace(P, elevation_min_deg=-90.0, elevation_max_deg=90.0)
+    assert len(blind_sphere_points(AGENT, everywhere)) == 0
+
+
+def test_a_narrow_lidar_band_gives_no_frontier_off_the_drift_nor_in_its_blind_cones():
+    """A legged robot's +-15 deg LiDAR never sees the roof of a 3 m drift within 9 m, nor the walls'
+    tops beside it: the hull's rim over those blind cones made frontiers behind the walls and
+    over the robot's head."""
+    surface = corridor(-30.0, 60.0)                          # 4 m wide, 3 m high
+    cache, seq = PointCache(P.d_vox_m), SequentialFrontiers(P)
+    for x in range(9):
+        sensor = np.array([float(x), 0.3, 0.6])
+        cache.insert(banded_scan(surface, sensor), sensor)
+        update = seq.update(float(x), sensor, cache.cloud(sensor, P))
+    points = np.concatenate([f.points for f in update.frontiers])
+    assert np.all(np.abs(points[:, 1]) <= 2.0 + 0.05) and np.all(points[:, 2] <= 3.0 + 0.05)
+    centroids, _, areas = triangle_geometry(update.mesh)
+    up = centroids[update.mesh.frontier] - sensor
+    elevation = np.degrees(np.arctan2(up[:, 2], np.linalg.norm(up[:, :2], axis=1)))
+    assert areas[update.mesh.frontier][elevation > P.elevation_max_deg + 2.0].sum() < 0.05 * \
+        areas[update.mesh.frontier].sum()
+    big = [f for f in update.frontiers if f.area > 5.0]       # the drift's two open ends
+    assert len(big) == 2 and sorted(np.sign(f.mean[0] - sensor[0]) for f in big) == [-1.0, 1.0]
+
+
+def test_a_shaft_straight_above_is_a_frontier_only_for_a_robot_that_sees_into_its_blind_cones():
+    room = box((-3, -3, -1), (3, 3, 2))
+    room = room[~((np.abs(room[:, 0]) < 1.0) & (np.abs(room[:, 1]) < 1.0) & (room[:, 2] > 1.9))]   # a hole
+    shaft = np.concatenate([rectangle((-1, y, 2), (2, 0, 0), (0, 0, 18)) for y in (-1, 1)]
+                           + [rectangle((x, -1, 2), (0, 2, 0), (0, 0, 18)) for x in (-1, 1)])
+    cache = PointCache(P.d_vox_m)
+    cache.insert(np.concatenate([room, shaft]), np.zeros(3))
+    uav = dataclasses.replace(P, elevation_min_deg=-45.0, elevation_max_deg=45.0)
+    for blind, above in ((False, 0), (True, 1)):
+        params = dataclasses.replace(uav, blind_frontiers=blind)
+        mesh, _ = visible_mesh(cache.cloud(np.zeros(3), params), np.zeros(3), params)
+        centroids, _, _ = triangle_geometry(mesh)
+        up = centroids[mesh.frontier]
+        assert ((up[:, 2] > 5.0) & (np.linalg.norm(up[:, :2], axis=1) < 1.0)).any() == bool(above)
 
 
 def test_sphere_points_straight_behind_an_observed_point_are_left_out_of_the_hull():

@@ -6,13 +6,15 @@ from dataclasses import replace
 
 import numpy as np
 import py_trees
+from delve.planners.occupancy import FREE, OCCUPIED
 from delve.skills.csiro import FollowFrontierGoal, SelectUavFrontier, SelectUgvFrontier, UpdateFrontiers, \
     csiro_state
+from delve.skills.navigation import navigator
 from py_trees.common import Status
 
 from ..fakes import FakeRobot, events, make_ctx, run
 from .conftest import sweep
-from .test_selection import ground_robot
+from .test_selection import ground_robot, summary
 
 
 def selected(tunnel, frontiers_at=(40.0,)):
@@ -77,3 +79,71 @@ def test_an_observer_beyond_the_onboard_map_s_graph_is_approached_as_near_as_it_
     assert robot.paths and "nearest reachable" in events(ctx, "goto")[0]["source"]
     end = robot.paths[0][-2]                              # GoTo appends the goal itself
     assert abs(end[0] - 12.0) < 1.0 and end[1] > 6.5     # the tunnel's side nearest the goal
+
+
+def test_a_teammate_s_frontier_is_done_on_reaching_its_observer_and_the_place_joins_the_trajectory(tunnel):
+    robot, ctx, st = ground_robot(tunnel, ())
+    for x in np.arange(7.0, 46.0, 1.0):
+        node = st.topometric.add_pose("r2", x, [x, 6.5, 1.5])
+        if node is not None:
+            st.topometric.connect(node, ("r1", node[1]))          # r2 walked beside r1
+    s = st.summaries[("r2", 0)] = summary("r2", 0, 12.0)
+    st.topometric.attach_frontier(s.key, "r2", 12.0, s.observer + [0, 0, 0.5])
+    SelectUgvFrontier("select", ctx).tick_once()
+    before = len(st.trajectory)
+    assert run(FollowFrontierGoal("follow", ctx), ctx, robot, ticks=30) == Status.SUCCESS
+    assert events(ctx, "csiro_goal_done")[0]["why"] == "reached a teammate's frontier"
+    assert not events(ctx, "csiro_goal_failed")                  # only r2 could have changed it
+    assert len(st.trajectory) == before + 1
+    assert np.linalg.norm(st.trajectory.points()[-1] - [12.0, 6.0, 1.5]) <= 1.0
+
+
+def test_an_own_frontier_that_changes_while_the_robot_stands_there_is_done(tunnel):
+    robot, ctx, st, node = selected(tunnel, frontiers_at=(12.0,))
+    for _ in range(20):
+        run(node, ctx, robot, ticks=1)
+        if node.feedback_message.startswith("at the goal"):
+            break
+    assert node.status == Status.RUNNING and node.feedback_message.startswith("at the goal")
+    st.summaries[("r1", 0)] = replace(st.summaries[("r1", 0)], updated_s=ctx.clock.now_s)   # part of it seen
+    assert run(node, ctx, robot, ticks=2) == Status.SUCCESS
+    assert events(ctx, "csiro_goal_done")[0]["why"] == "changed" and not events(ctx, "csiro_goal_failed")
+
+
+def test_an_observer_beyond_a_stale_navigation_graph_is_planned_on_the_graph_rebuilt(tunnel):
+    grid, a, _ = tunnel
+    robot, ctx, st, _ = selected(tunnel, frontiers_at=(30.0,))
+    st.topometric.detach_frontier(("r1", 0))                # no topometric path: the navigation graph's
+    wall = np.zeros(grid.shape, bool)
+    wall[grid.to_index(np.array([[a[0] + 20.0, a[1], a[2]]]))[0, 0], :, :] = True
+    free = grid.occupancy == FREE
+    robot.onboard_map.write(wall & free, OCCUPIED)              # the drift blocked when the graph is built
+    navigator(ctx, robot).graph()
+    robot.onboard_map.write(wall & free, FREE)                  # then seen open, seconds later
+    assert run(FollowFrontierGoal("follow", ctx, max_replans=0), ctx, robot, ticks=2) == Status.RUNNING
+    assert events(ctx, "goto")[0]["source"] == "navigator" and not events(ctx, "csiro_goal_failed")
+
+
+def test_a_uav_short_of_its_frontier_on_a_stale_graph_goes_on_to_the_place_the_rebuilt_graph_reaches(
+        tunnel, tunnel_points):
+    grid, a, _ = tunnel
+    robot = FakeRobot(grid, a + np.array([18.0, 0.0, 1.5]), platform="aerial")
+    ctx = make_ctx(robot)
+    sweep(robot, tunnel_points)
+    UpdateFrontiers("update", ctx).tick_once()
+    wall = np.zeros(grid.shape, bool)
+    wall[grid.to_index(np.array([a + [13.0, 0.0, 0.0]]))[0, 0], :, :] = True      # behind the robot
+    free = grid.occupancy == FREE
+    robot.onboard_map.write(wall & free, OCCUPIED)              # the graph is built with the drift blocked
+    SelectUavFrontier("select", ctx).tick_once()
+    robot.onboard_map.write(wall & free, FREE)                  # then seen open
+    st = csiro_state(ctx)
+    key = py_trees.blackboard.Blackboard.storage["/r1/csiro_goal"]
+    centre = next(f.mean for f in st.frontiers.frontiers if f.id == key[1])
+    assert centre[0] < a[0] + 11.0                              # the frontier behind, beyond the wall's place
+    first = np.array(py_trees.blackboard.Blackboard.storage["/r1/goal"])
+    assert first[0] > a[0] + 13.0                               # the stale graph's nearest place
+    node = FollowFrontierGoal("follow", ctx, tolerance_m=0.5)
+    assert run(node, ctx, robot, ticks=40) == Status.SUCCESS
+    assert events(ctx, "csiro_goal_done")[0]["why"] == "complete" and not events(ctx, "csiro_goal_failed")
+    assert len(events(ctx, "goto")) >= 2 and events(ctx, "goto")[-1]["goal"][0] < first[0] - 1.0

@@ -17,6 +17,13 @@ def test_state_is_made_once_from_the_config_with_the_lidar_s_elevations(tunnel):
     assert st is csiro_state(ctx, view_up_deg=10.0)
     assert st.frontier_params.d_max_m == 7.0
     assert (st.frontier_params.elevation_min_deg, st.frontier_params.elevation_max_deg) == (-45.0, 45.0)
+    assert not st.frontier_params.blind_frontiers
+
+
+def test_a_flying_robot_s_blind_cones_hold_frontiers(tunnel):
+    grid, a, _ = tunnel
+    st = csiro_state(make_ctx(FakeRobot(grid, body(a), platform="aerial")), view_up_deg=45.0)
+    assert st.frontier_params.blind_frontiers
 
 
 def test_places_of_equation_14_hold_trajectories_goals_and_failed_goals(tunnel):
