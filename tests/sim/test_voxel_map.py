@@ -18,6 +18,27 @@ def test_scan_carves_free_space_and_marks_hits():
     assert m.version == 1
 
 
+def test_scans_carve_the_same_with_int32_and_int64_voxel_indices():
+    """Samples of rays leaving the grid on every side (negative indices, beyond its end) are
+    dropped alike by the int32 path's unsigned bounds test and the int64 path's."""
+    rng = np.random.default_rng(3)
+    maps = [VoxelMap((30, 20, 10), np.zeros(3), 0.2) for _ in range(2)]
+    maps[1]._axis_dtype = np.int64
+    log = [m.change_log() for m in maps]
+    for _ in range(5):
+        sensor = rng.uniform([0.5, 0.5, 0.5], [5.5, 3.5, 1.5])
+        dirs = rng.normal(size=(400, 3))
+        dirs /= np.linalg.norm(dirs, axis=1)[:, None]
+        ranges = np.where(rng.random(400) < 0.5, rng.uniform(0.1, 8.0, 400), np.inf).astype(np.float32)
+        for m in maps:
+            m.integrate_scan(sensor, dirs, ranges, 8.0)
+    assert maps[0]._axis_dtype == np.int32
+    np.testing.assert_array_equal(maps[0].occupancy, maps[1].occupancy)
+    np.testing.assert_array_equal(maps[0].free_voxels(), maps[1].free_voxels())
+    np.testing.assert_array_equal(log[0].take(), log[1].take())
+    assert (maps[0].occupancy == FREE).any() and (maps[0].occupancy == OCCUPIED).any()
+
+
 def test_free_never_overwrites_occupied():
     m = VoxelMap((20, 5, 5), np.zeros(3), 0.2)
     m.occupancy[10, 2, 2] = OCCUPIED

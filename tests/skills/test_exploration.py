@@ -183,3 +183,11 @@ def test_interrupted_it_stops_its_own_motion_and_plans_afresh(half_mapped):
     assert explore.status == Status.RUNNING and len(robot.paths) == 2
     assert not events(ctx, "frontier_blacklisted")  # an interruption is no verdict on the frontier
 
+
+def test_sorted_contains_answers_as_isin():
+    from delve.skills.exploration import _sorted_contains
+    rng = np.random.default_rng(0)
+    for n in (0, 1, 50):
+        values = np.unique(rng.integers(0, 200, n))
+        query = rng.integers(-5, 210, 300)
+        np.testing.assert_array_equal(_sorted_contains(values, query), np.isin(query, values))
