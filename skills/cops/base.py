@@ -74,7 +74,7 @@ class CopsSkill(Skill):
         collect_own_map(self.ctx, st.knowledge)
         self.radio.send(self.p["leader"], KIND, {"type": "hello", "home": True, "payload": st.knowledge.payload()})
 
-    def drive_to(self, there: str, arrive: bool = False) -> Status | None:
+    def drive_to(self, there: str, arrive: bool = False, short_is_there: bool = True) -> Status | None:
         """Drive towards location ``there`` through the NetworkView: None once there
         (in its region; with ``arrive``, at the end of its route to the position, or as
         near the position as the robot can get inside the region), RUNNING on the way,
@@ -84,7 +84,10 @@ class CopsSkill(Skill):
         reaches further as the robot walks) is asked for again where it ends. A name
         the view knows under another (a lattice cell merged into a region, see
         :func:`view_name`) is driven to under the view's name; one it does not know
-        yet, to the position the agent's knowledge gives (:meth:`_hint`)."""
+        yet, to the position the agent's knowledge gives (:meth:`_hint`). Where the
+        robot's own map takes it no nearer that position, it is there as far as it
+        can tell (a plan's move goes on) or, without ``short_is_there``, it has no
+        route (exploration: the location is out of its reach, not explored)."""
         view, robot = network_view(self.ctx), self.robot
         there = view_name(view, there, self.state.knowledge.topology)
         hint = self._hint(view, there)
@@ -99,7 +102,7 @@ class CopsSkill(Skill):
             route = view.route(there) if hint is None else view.route_towards(hint)
             if hint is not None and route is not None and \
                     np.linalg.norm(np.asarray(route)[-1] - robot.position) < HINT_PROGRESS_M:
-                route, inside = None, True  # its own map takes it no nearer
+                route, inside = None, inside or short_is_there  # its own map takes it no nearer
             if route is None and inside:  # as near as it gets
                 self._driving, self._settled = None, there
                 return None

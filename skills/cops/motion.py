@@ -118,12 +118,17 @@ class ExplorationAction(CopsSkill):
     choices (at the frontier: its unexplored exits; further on: the tunnels other than
     the one it came by), choice = i mod c, i = i div c, move one location towards the
     choice. Robots sent to one frontier thus spread over its branches (Figure 5). A
-    choice the robot cannot reach (no route, or blocked) is dropped and the robot
-    chooses again among the others, with i as it was. At a dead end it waits. Runs
-    until the Exploration Timer stops it.
+    location the robot has arrived at is explored: on a voxel world it arrives near
+    the location's position, which may lie in the cell above the floor the robot
+    walks on, or the location may be one only its knowledge shows, and its own map
+    would then never count the cell visited (a frontier's target for good). A choice
+    the robot cannot reach (no route, blocked, or its own map takes it no nearer) is
+    dropped and the robot chooses again among the others, with i as it was. At a
+    dead end it waits. Runs until the Exploration Timer stops it.
 
-    Reads ``cops`` (the plan's exploration task and network); drives the robot.
-    Logs ``exploration_choice`` and ``exploration_unreachable``. Returns RUNNING.
+    Reads/writes ``cops`` (the plan's exploration task; the knowledge's explored and
+    unreachable locations); drives the robot. Logs ``exploration_choice`` and
+    ``exploration_unreachable``. Returns RUNNING.
     """
 
     def initialise(self) -> None:
@@ -141,7 +146,7 @@ class ExplorationAction(CopsSkill):
         topo = st.knowledge.topology
         self._rename(topo)
         if self._moving is not None:
-            moving = self.drive_to(self._moving)
+            moving = self.drive_to(self._moving, short_is_there=False)
             if moving == Status.RUNNING:
                 return moving
             if moving == Status.FAILURE:
@@ -151,6 +156,8 @@ class ExplorationAction(CopsSkill):
                 return Status.RUNNING
             self._prev, self._at, self._moving = self._at, self._moving, None
             self._visited.add(self._at)
+            if self._at in topo.locations:
+                topo.explored.add(self._at)
         if self._prev is None:
             explored = {topo.resolve(s) for s in st.plan.meta.get("explored", ())} | self._visited | topo.unreachable
             cands = [s for s in topo.neighbours(self._at) if s not in explored]

@@ -509,3 +509,56 @@ def test_a_location_only_a_partner_has_mapped_is_driven_to_where_the_knowledge_p
     action.tick_once()
     assert action.status == Status.SUCCESS and robot.at == 6 and events == []
     py_trees.blackboard.Blackboard.clear()
+
+
+class MapEndWalker(ShortSightedWalker):
+    """A ShortSightedWalker whose own map takes it no further than s4."""
+
+    def route_towards(self, point) -> np.ndarray:
+        return np.array([[min(float(point[0]), 4.0), 0.0, 0.0]])
+
+
+def exploring_from_s3(robot, events: list) -> tuple[ExplorationAction, Topology]:
+    """r1 explores from frontier s3 (explored) towards s6, which only its knowledge shows."""
+    action = ExplorationAction("Exploration action", walker_context(robot, events))
+    st = action.state
+    topo = st.knowledge.topology
+    for i in (3, 6):
+        topo.add_location(f"s{i}", (float(i), 0.0, 0.0), explored=i == 3)
+    topo.add_mobility_edge("s3", "s6")
+    idle = Plan(horizon=0, trajectories={"r1": ["s3"]}, masters=["r1"], phase="pre")
+    st.plan = CyclePlan(idle, idle, {"r1": ExplorationTask("s3", 0, 0, 4, 0)})
+    for _ in range(6):
+        action.tick_once()
+        robot.step()
+    return action, topo
+
+
+def test_a_location_the_exploration_arrived_at_is_explored_though_the_robot_s_map_never_shows_it():
+    """cops_mine (issue 16): robots arrived at cells that their own maps never counted
+    as visited, and those cells stayed frontiers' targets: the mission never ended."""
+    events: list = []
+    robot = ShortSightedWalker(at=3)
+    action, topo = exploring_from_s3(robot, events)
+    assert robot.at == 6 and [f["choice"] for e, f in events if e == "exploration_choice"] == ["s6"]
+    assert "s6" in topo.explored and topo.frontiers() == set()
+    py_trees.blackboard.Blackboard.clear()
+
+
+def test_where_its_own_map_takes_it_no_nearer_a_plan_s_move_is_done_and_an_exploration_s_choice_unreachable():
+    events: list = []
+    robot = MapEndWalker(at=4)
+    ctx = walker_context(robot, events)
+    move = TransitionAction("Transition action", ctx)
+    step = Plan(horizon=1, trajectories={"r1": ["s4", "s6"]}, masters=["r1"], phase="pre")
+    st = move.state
+    st.knowledge.topology.add_location("s6", (6.0, 0.0, 0.0), explored=True)
+    st.plan, st.cycle, st.part, st.step = CyclePlan(step, step, {}), 2, "pre", 0
+    move.tick_once()
+    assert move.status == Status.SUCCESS and st.step == 1 and events == []
+    robot = MapEndWalker(at=3)
+    events.clear()
+    action, topo = exploring_from_s3(robot, events)
+    assert robot.at == 4 and [f["choice"] for e, f in events if e == "exploration_unreachable"] == ["s6"]
+    assert topo.unreachable == {"s6"} and "s6" not in topo.explored and topo.frontiers() == set()
+    py_trees.blackboard.Blackboard.clear()
