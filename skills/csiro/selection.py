@@ -12,6 +12,7 @@ from py_trees.ports import PortInformation
 from ...planners.csiro.selection import select_uav_frontier, select_ugv_frontier
 from ...planners.csiro.topometric import frontier_node
 from ...planners.geometry import xyz
+from ...planners.visibility import line_of_sight
 from ..base import Param, Skill
 from .follow import reachable_near
 from .frontiers import body_lift
@@ -84,7 +85,10 @@ class SelectUgvFrontier(_Select):
 class SelectUavFrontier(_Select):
     """Equation 16 for a flying robot, over its own frontiers: size, z-weighted distance and
     momentum, none smaller than the size limit, blacklisted or complete. Its goal is the place
-    of the navigation graph it can reach that lies nearest the frontier's centre.
+    of the navigation graph it can reach that lies nearest the frontier's centre. A frontier
+    whose centre lies behind rock of the onboard map seen from that place (a patch of its blind
+    cones beyond a roof or floor it had not sampled densely) is blacklisted at once
+    (``csiro_frontier_behind_surface``) and the next one taken.
 
     Writes ``goal`` and ``csiro_goal``. Returns SUCCESS with a goal; RUNNING while none is
     selectable, up to ``wait_s``; then FAILURE (exploration over).
@@ -93,14 +97,27 @@ class SelectUavFrontier(_Select):
     def update(self) -> Status:
         r, name = self.robot, self.ctx.name
         st = csiro_state(self.ctx, r.view_up_deg)
-        picked = select_uav_frontier(st.frontiers.frontiers, r.position, st.momentum, st.selection,
-                                     blacklist=sorted(st.blacklist))
-        if picked is None:
-            return self.none_left()
-        frontier, st.momentum = picked
-        near = reachable_near(self.ctx, r, frontier.mean)
+        while True:   # each turn blacklists one frontier more
+            picked = select_uav_frontier(st.frontiers.frontiers, r.position, st.momentum, st.selection,
+                                         blacklist=sorted(st.blacklist))
+            if picked is None:
+                return self.none_left()
+            frontier, momentum = picked
+            near = reachable_near(self.ctx, r, frontier.mean)
+            if in_sight(r.onboard_map, r.position if near is None else near[1], frontier.mean):
+                break
+            st.blacklist.add(frontier.id)
+            self.event("csiro_frontier_behind_surface", id=frontier.id, centre=xyz(frontier.mean, 2))
+        st.momentum = momentum
         return self.chosen((name, frontier.id), frontier.mean if near is None else near[1],
                            area_m2=round(frontier.area, 2))
+
+
+def in_sight(voxel_map: Any, eye: np.ndarray, point: np.ndarray) -> bool:
+    """Whether the straight line from ``eye`` to ``point`` crosses no occupied voxel of
+    ``voxel_map`` (but those next to ``point``'s)."""
+    ijk = np.floor((np.asarray(point, float) - voxel_map.origin) / voxel_map.voxel_size_m).astype(np.int64)
+    return bool(line_of_sight(voxel_map, eye, ijk[None])[0])
 
 
 __all__ = ["SelectUavFrontier", "SelectUgvFrontier"]

@@ -6,7 +6,7 @@ from dataclasses import replace
 
 import numpy as np
 import py_trees
-from delve.planners.occupancy import FREE, OCCUPIED
+from delve.planners.occupancy import FREE, OCCUPIED, UNKNOWN
 from delve.skills.csiro import FollowFrontierGoal, SelectUavFrontier, SelectUgvFrontier, UpdateFrontiers, \
     csiro_state
 from delve.skills.navigation import navigator
@@ -134,7 +134,7 @@ def test_a_uav_short_of_its_frontier_on_a_stale_graph_goes_on_to_the_place_the_r
     wall = np.zeros(grid.shape, bool)
     wall[grid.to_index(np.array([a + [13.0, 0.0, 0.0]]))[0, 0], :, :] = True      # behind the robot
     free = grid.occupancy == FREE
-    robot.onboard_map.write(wall & free, OCCUPIED)              # the graph is built with the drift blocked
+    robot.onboard_map.write(wall & free, UNKNOWN)               # the graph is built with a gap in the map
     SelectUavFrontier("select", ctx).tick_once()
     robot.onboard_map.write(wall & free, FREE)                  # then seen open
     st = csiro_state(ctx)

@@ -3,7 +3,9 @@ distance (equation 15, Algorithm 3) and the flying robot's by equation 16."""
 from __future__ import annotations
 
 import numpy as np
+from delve.planners.csiro.frontier_types import Frontier
 from delve.planners.csiro.sharing import FrontierSummary
+from delve.planners.occupancy import OCCUPIED
 from delve.skills.csiro import SelectUavFrontier, SelectUgvFrontier, UpdateFrontiers, csiro_state
 from py_trees.common import Status
 
@@ -95,3 +97,21 @@ def test_uav_flies_for_its_own_frontier_and_skips_blacklisted_ones(tunnel, tunne
     st.blacklist.add(first[1])
     node.tick_once()
     assert node.status == Status.SUCCESS and bb("csiro_goal") != first
+
+
+def test_uav_blacklists_a_frontier_whose_centre_lies_behind_mapped_rock(tunnel, tunnel_points):
+    grid, a, _ = tunnel
+    robot = FakeRobot(grid, a + np.array([18.0, 0.0, 1.5]), platform="aerial")
+    ctx = make_ctx(robot)
+    sweep(robot, tunnel_points)
+    UpdateFrontiers("update", ctx).tick_once()
+    st = csiro_state(ctx)
+    beyond = a + np.array([18.0, 5.0, 1.5])                  # 5 m aside, through the tunnel's wall
+    assert grid.value_at(a[None] + [[18.0, 2.1, 1.5]])[0] == OCCUPIED
+    big = Frontier(id=99, points=beyond[None], normals=np.array([[0.0, 0.0, 1.0]]), areas=np.array([25.0]),
+                   mean=beyond, cov=np.diag([4.0, 4.0, 0.01]))
+    st.frontiers._frontiers[99] = big                          # the largest, nearest: eq. 16 would take it
+    node = SelectUavFrontier("select", ctx)
+    node.tick_once()
+    assert node.status == Status.SUCCESS and bb("csiro_goal")[1] != 99 and 99 in st.blacklist
+    assert events(ctx, "csiro_frontier_behind_surface")[0]["id"] == 99
