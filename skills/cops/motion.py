@@ -156,8 +156,7 @@ class ExplorationAction(CopsSkill):
                 return Status.RUNNING
             self._prev, self._at, self._moving = self._at, self._moving, None
             self._visited.add(self._at)
-            if self._at in topo.locations:
-                topo.explored.add(self._at)
+            topo.explored.add(self._at)
         if self._prev is None:
             explored = {topo.resolve(s) for s in st.plan.meta.get("explored", ())} | self._visited | topo.unreachable
             cands = [s for s in topo.neighbours(self._at) if s not in explored]
