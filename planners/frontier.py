@@ -311,12 +311,12 @@ def nearest_frontier(
     sizes = np.array([len(p) for p in picks])
     first = np.cumsum(sizes) - sizes
     points, normals = view_targets(grid, np.concatenate(picks))
-    pair = np.repeat(np.arange(len(owner)), sizes[owner])
-    start = np.repeat(np.cumsum(sizes[owner]) - sizes[owner], sizes[owner])
-    sample = first[owner][pair] + np.arange(len(pair)) - start   # each pair's cluster's samples
+    # Each candidate against its cluster's samples: a row per candidate, padded to the most samples.
+    col = np.arange(sizes.max())
+    sample = np.minimum(first[owner][:, None] + col, len(points) - 1)
     slack = 0.5 * grid.voxel_size_m
-    seen = observes(sensor[pair], points[sample], normals[sample], view_up_deg, max_goal_offset_m, slack)
-    share = np.bincount(pair, weights=seen, minlength=len(owner)) / sizes[owner]
+    seen = observes(sensor[:, None, :], points[sample], normals[sample], view_up_deg, max_goal_offset_m, slack)
+    share = (seen & (col < sizes[owner][:, None])).sum(axis=1) / sizes[owner]
     best = np.zeros(len(clusters))
     np.maximum.at(best, owner, share)
     worth = best * np.array([c.size for c in clusters]) >= min_targets
