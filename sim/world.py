@@ -34,10 +34,6 @@ MESH_SUFFIXES = (".ply", ".obj", ".stl")
 FLOOR_HEADROOM_M = 1.0
 
 
-#: Casts of at least this many rays use all of open3d's threads, smaller ones one.
-PARALLEL_RAYS = 2048
-
-
 @dataclass(frozen=True)
 class WorldSource:
     """How a world was loaded from a file (see :mod:`delve.sim.worldfile`).
@@ -225,10 +221,7 @@ class World:
         if len(o) == 0:
             return np.zeros(0, dtype=np.float32)
         rays = o3d.core.Tensor(np.ascontiguousarray(np.concatenate([o, d], axis=1)))
-        # A few rays (a robot's ground probe, a radio link) on one thread: waking open3d's
-        # thread pool costs more than they do (7 against up to 160 µs for one ray on a busy machine).
-        threads = 1 if len(o) < PARALLEL_RAYS else 0
-        t = self.scene.cast_rays(rays, nthreads=threads)["t_hit"].numpy()
+        t = self.scene.cast_rays(rays)["t_hit"].numpy()
         t[~(t <= np.float32(max_range_m))] = np.inf
         return t
 
