@@ -1,15 +1,17 @@
-"""Incremental maps (issue 17 item 1): time per update of the legged navigation graph
-and of the frontier set, updated from the changed voxels against recomputed over the
-whole map, at every navigation-graph update of a real mission, with a check that the
-two agree.
+"""Incremental maps (issue 17 item 1): time per update of the legged navigation graph,
+of the frontier set and (COPS on voxel worlds) of the COPS network extraction, updated
+from the changed voxels against recomputed over the whole map, at every update of a
+real mission, with a check that the two agree.
 
     .venv/bin/python bench/incremental_maps.py [--scenario scenarios/demo.yaml]
 
 The mission runs as usual (its navigators update their legged graphs from the maps'
-change logs); at each update this benchmark also builds the graph with
-``legged_graph`` and the frontier set with ``frontier_voxels`` and with a
-``FrontierUpdater`` on its own change log, times each, and checks that the results are
-equal. Prints the medians and totals over the mission.
+change logs, COPS views their topologies); at each update this benchmark also builds
+the graph with ``legged_graph`` and the frontier set with ``frontier_voxels`` and with
+a ``FrontierUpdater`` on its own change log, and extracts the COPS topology with
+``extract_topology`` (with the dense standable and passable masks it takes), times
+each, and checks that the results are equal. Prints the medians and totals over the
+mission, and the ratio of the medians (whole map / incremental).
 """
 from __future__ import annotations
 
@@ -24,9 +26,12 @@ import numpy as np
 
 from delve.executive.runner import Mission
 from delve.executive.scenario import load_scenario
+from delve.planners.cops.extraction import extract_topology
+from delve.planners.cops.extraction_incremental import ExtractionUpdater
 from delve.planners.frontier import frontier_voxels
 from delve.planners.frontier_incremental import FrontierUpdater
 from delve.planners.navgraph import legged_graph
+from delve.planners.occupancy import FREE
 from delve.skills import navigation
 
 TIMES: dict[str, list[float]] = defaultdict(list)
@@ -68,21 +73,55 @@ def instrument() -> None:
     navigation.Navigator._legged_graph = wrapper
 
 
+def instrument_cops() -> None:
+    """Wrap ExtractionUpdater.update: time it, and compare with extract_topology."""
+    incremental = ExtractionUpdater.update
+
+    def wrapper(self, grid, changed=None, *, standable=None, visited=None, prior=None, keep=()):
+        topo = timed("COPS extraction, incremental", incremental, self, grid, changed, standable=standable,
+                     visited=visited, prior=prior, keep=keep)
+        full = timed("COPS extraction, whole map", whole_map_extraction, self, grid, standable, visited=visited,
+                     prior=prior, keep=keep)
+        if topo != full:
+            MISMATCHES.append(f"COPS extraction {len(TIMES['COPS extraction, incremental'])}")
+        return topo
+
+    ExtractionUpdater.update = wrapper
+
+
+def whole_map_extraction(updater: ExtractionUpdater, grid, standable, **kwargs):
+    """``extract_topology`` with the updater's parameters, as the COPS view called it
+    before (dense masks of the standable and of the passable voxels)."""
+    mask = np.zeros(grid.shape, dtype=bool)
+    mask.reshape(-1)[standable] = True
+    return extract_topology(grid.occupancy, grid.origin, grid.voxel_size_m, standable=mask,
+                            passable=grid.occupancy == FREE, free=grid.free, cell_m=updater.cell_m,
+                            comm_range_m=updater.comm_range_m, min_free_voxels=updater.min_free_voxels,
+                            sight_height_m=updater.sight_height_m, lattice_origin=updater.corner,
+                            open_radius_m=updater.open_radius_m, max_region_m=updater.max_region_m, **kwargs)
+
+
 def main() -> int:
     ap = argparse.ArgumentParser()
     ap.add_argument("--scenario", type=Path, default=Path(__file__).parent.parent / "scenarios" / "demo.yaml")
     args = ap.parse_args()
     scenario = load_scenario(args.scenario)
     instrument()
+    instrument_cops()
     mission = Mission(scenario, world=scenario.build_world())
     mission.run()
     print(f"$ {' '.join(sys.argv)}")
-    n = len(TIMES["free voxels"])
-    print(f"scenario {scenario.name}: {n} navigation-graph updates, up to {max(TIMES['free voxels']):,} free voxels\n")
-    print(f"{'per update':<28}{'median ms':>10}{'total s':>9}")
-    for key in ("legged graph, whole map", "legged graph, incremental", "frontier set, whole map",
-                "frontier set, incremental"):
-        print(f"{key:<28}{statistics.median(TIMES[key]) * 1e3:>10.1f}{sum(TIMES[key]):>9.2f}")
+    n, cops = len(TIMES["free voxels"]), len(TIMES["COPS extraction, incremental"])
+    extractions = f", {cops} COPS network extractions" if cops else ""
+    print(f"scenario {scenario.name}: {n} navigation-graph updates{extractions}, "
+          f"up to {max(TIMES['free voxels']):,} free voxels\n")
+    print(f"{'per update':<30}{'median ms':>10}{'total s':>9}{'ratio':>8}")
+    for part in ("legged graph", "frontier set") + (("COPS extraction",) if cops else ()):
+        whole = statistics.median(TIMES[f"{part}, whole map"])
+        for key in (f"{part}, whole map", f"{part}, incremental"):
+            median = statistics.median(TIMES[key])
+            ratio = f"{whole / median:>7.1f}x" if key.endswith("incremental") else ""
+            print(f"{key:<30}{median * 1e3:>10.1f}{sum(TIMES[key]):>9.2f}{ratio}")
     print(f"\nincremental equal to whole-map results at every update: {'yes' if not MISMATCHES else MISMATCHES}")
     return 0 if not MISMATCHES else 1
 
