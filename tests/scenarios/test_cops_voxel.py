@@ -24,3 +24,16 @@ def test_the_cops_trees_explore_a_3d_mine_and_bring_the_map_home(tmp_path):
         assert node in dump
     _, again = run_scenario(DATA / "cops_mine_small.yaml", tmp_path / "b")
     assert json.dumps(strip_wall_clock(report)) == json.dumps(strip_wall_clock(again))
+
+
+def test_locations_the_explorers_arrived_at_are_explored_and_the_mission_ends(tmp_path):
+    """Robots arrive at locations whose cells their own maps never count as visited
+    (cops_mine never ended so, issue 16): each is explored all the same, no frontier
+    is left, and the team is recalled home well before the duration."""
+    _, report = run_scenario(DATA / "cops_mine_arrivals.yaml", tmp_path)
+    assert report["succeeded"] and not report["outcome"]["timed_out"], report["outcome"]
+    plans = report["cops"]["plans"]
+    assert plans[-1]["final"] and plans[-1]["frontiers"] == 0
+    assert report["coverage_fraction"] > 0.95
+    assert report["sim_time_s"] < 300
+    assert all(r["returned_home"] for r in report["robots"])
