@@ -121,6 +121,7 @@ class FollowFrontierGoal(GoTo):
                 status = self.plan()
                 return self._failed(st, self.feedback_message) if status == Status.FAILURE else Status.RUNNING
             self.arrived_s, self.arrived_version = now, version
+            st.look_due = True
         if version != self.arrived_version:
             return self._done("changed")
         if now - self.arrived_s >= self.p["dwell_s"]:
@@ -181,25 +182,37 @@ class FollowFrontierGoal(GoTo):
         return Status.FAILURE
 
     def _path(self, grid: Any) -> tuple[np.ndarray | None, str, str, str]:
-        """The topometric map's path first (ground robot), then ``GoTo``'s; where that finds none
-        (an observer beyond what the onboard map's graph covers yet), the way to the reachable
-        place nearest the goal, when it brings the robot nearer by ``progress_m`` at least."""
+        """For a goal beyond d_max (a distant frontier, Section IV-C) the topometric map's path
+        first (ground robot); else, and then, ``GoTo``'s on the navigation graph (rebuilt from the
+        current map when the goal lies beyond the graph it has); where that finds none, the
+        topometric path to a nearby goal, else the way to the reachable place nearest the goal
+        when it brings the robot nearer by ``progress_m`` at least."""
         st, r = csiro_state(self.ctx), self.robot
-        if self.replans == 0 and not r.mobility.aerial:
-            path = st.topometric.path(r.position, frontier_node(self.key))
-            if path is not None and len(path.points) > 2:
-                return path.points[1:-1], "topometric", "", ""   # the goal is appended by GoTo
+        first = self.replans == 0 and not r.mobility.aerial
+        far = float(np.linalg.norm(self.goal - r.position)) > st.frontier_params.d_max_m
+        if first and far and (path := self._topometric(st)) is not None:
+            return path, "topometric", "", ""
         path, source, code, why = super()._path(grid)
         nav = navigator(self.ctx, r)
         if path is None and code == "no_path" and self.replans == 0 and nav.map_changed():
-            nav.graph(force=True)   # the graph may be rebuild_period_s old: the observer lies beyond it
+            nav.graph(force=True)   # the graph may be rebuild_period_s old: the goal lies beyond it
             path, source, code, why = super()._path(grid)
+        if path is None and code == "no_path" and first and not far:
+            topometric = self._topometric(st)
+            if topometric is not None:
+                return topometric, "topometric", "", ""
         if path is None and code == "no_path":
             near = reachable_near(self.ctx, r, self.goal)
             if near is not None and (np.linalg.norm(near[1] - self.goal) + st.selection.progress_m
                                      <= np.linalg.norm(r.position - self.goal)):
                 return near[0], "navigator, nearest reachable", "", ""
         return path, source, code, why
+
+    def _topometric(self, st: CsiroState) -> np.ndarray | None:
+        """The waypoints of the topometric map's A* path to the frontier (GoTo appends the goal),
+        or None when it has none beyond the robot's and the frontier's nodes."""
+        path = st.topometric.path(self.robot.position, frontier_node(self.key))
+        return path.points[1:-1] if path is not None and len(path.points) > 2 else None
 
 
 __all__ = ["FollowFrontierGoal"]

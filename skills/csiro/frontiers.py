@@ -30,8 +30,10 @@ class UpdateFrontiers(Skill):
     frontier on the current mesh (equation 13, seen with its LiDAR's elevations), hangs it off
     the topometric map and joins its current node to the trajectory nodes the mesh reaches; a
     frontier that no candidate's LiDAR sees (a patch of roof above the reachable floor) is no
-    useful frontier and is dropped. A degenerate cloud is no error: nothing changes,
-    ``csiro_no_view`` says why (once per cause).
+    useful frontier and is dropped; an unchanged frontier in range takes a candidate that
+    observes more of it than its observer does. A robot that has reached its goal
+    (``look_due``) updates there without the d_min of motion. A degenerate cloud is no error:
+    nothing changes, ``csiro_no_view`` says why (once per cause).
 
     Writes ``csiro_frontier_count`` (the robot's own frontiers). Logs ``csiro_frontiers`` when
     frontiers appear or go, ``csiro_frontiers_unobservable`` when some are dropped. Returns RUNNING.
@@ -59,7 +61,8 @@ class UpdateFrontiers(Skill):
         st.trajectory.add(now, pos)
         if not r.mobility.aerial:
             st.topometric.add_pose(self.ctx.name, now, pos)
-        if scans and (st.frontiers.due(now, pos) or self.no_view):
+        if scans and (st.frontiers.due(now, pos) or self.no_view or st.look_due):
+            st.look_due = False
             self._update(st, now, pos)
         self.write("csiro_frontier_count", len(st.frontiers.frontiers))
         return Status.RUNNING
@@ -84,7 +87,7 @@ class UpdateFrontiers(Skill):
         if upd.new_ids or upd.removed_ids:
             self.event("csiro_frontiers", count=len(upd.frontiers), new=list(upd.new_ids),
                        removed=list(upd.removed_ids))
-        if r.mobility.aerial or not changed:
+        if r.mobility.aerial:
             return
         lift = body_lift(r)
         candidates = observer_candidates(upd.mesh, r.position - lift, st.selection)
@@ -92,9 +95,10 @@ class UpdateFrontiers(Skill):
         if node is not None and len(candidates):
             st.topometric.connect_reachable(node, candidates.positions + lift, self.p["link_radius_m"])
         unseen = []
+        view = {"sensor_height_m": float(lift[2]),
+                "elevations_deg": (fp.elevation_min_deg, fp.elevation_max_deg)}
         for f in changed:
-            observer = plan_observer(candidates, f, fp.d_max_m, st.selection, sensor_height_m=float(lift[2]),
-                                     elevations_deg=(fp.elevation_min_deg, fp.elevation_max_deg))
+            observer = plan_observer(candidates, f, fp.d_max_m, st.selection, **view)
             if observer is None:
                 continue  # no place to observe it from here: the old observer stays
             if observer.reward <= 0.0:
@@ -102,6 +106,14 @@ class UpdateFrontiers(Skill):
                 continue
             summary = st.summaries[(name, f.id)] = summarise(f, name, observer, now)
             st.topometric.attach_frontier(summary.key, name, now, summary.observer + lift)
+        for f in upd.frontiers:  # unchanged ones in range: a better observer among today's candidates
+            old = st.summaries.get((name, f.id))
+            if before.get(f.id) is not f or old is None or np.linalg.norm(f.mean - sensor) > fp.d_max_m:
+                continue
+            observer = plan_observer(candidates, f, fp.d_max_m, st.selection, **view)
+            if observer is not None and observer.reward > old.reward:
+                st.summaries[old.key] = summarise(f, name, observer, old.updated_s)
+                st.topometric.attach_frontier(old.key, name, old.updated_s, observer.position + lift)
         if unseen:
             st.frontiers.discard(unseen)
             for fid in unseen:

@@ -65,6 +65,8 @@ class CsiroState:
     places: dict[str, np.ndarray] = field(default_factory=dict)
     goals: dict[str, tuple[FrontierKey, np.ndarray]] = field(default_factory=dict)
     goal: FrontierKey | None = None
+    #: A frontier update is due where the robot stands (it reached its goal to look from there).
+    look_due: bool = False
     #: The UAV's momentum (equation 16) and the frontier ids it blacklisted.
     momentum: UavMomentum | None = None
     blacklist: set[int] = field(default_factory=set)

@@ -147,3 +147,21 @@ def test_a_uav_short_of_its_frontier_on_a_stale_graph_goes_on_to_the_place_the_r
     assert run(node, ctx, robot, ticks=40) == Status.SUCCESS
     assert events(ctx, "csiro_goal_done")[0]["why"] == "complete" and not events(ctx, "csiro_goal_failed")
     assert len(events(ctx, "goto")) >= 2 and events(ctx, "goto")[-1]["goal"][0] < first[0] - 1.0
+
+
+def test_a_goal_within_d_max_takes_the_navigation_graph_not_the_topometric_detour(tunnel):
+    robot, ctx, st, node = selected(tunnel, frontiers_at=(8.0,))   # 2 m from the robot at x = 10 ...
+    st.topometric.detach_frontier(("r1", 0))
+    st.topometric.attach_frontier(("r1", 0), "r1", 45.0, np.array([8.0, 6.0, 1.5]))   # ... hung off x = 43
+    run(node, ctx, robot, ticks=1)
+    assert events(ctx, "goto")[0]["source"] == "navigator"
+
+
+def test_reaching_the_goal_asks_for_a_look_from_there(tunnel):
+    robot, ctx, st, node = selected(tunnel, frontiers_at=(12.0,))
+    assert not st.look_due
+    for _ in range(20):
+        run(node, ctx, robot, ticks=1)
+        if node.feedback_message.startswith("at the goal"):
+            break
+    assert st.look_due

@@ -2,6 +2,7 @@
 its trajectory and topometric map up to date from its LiDAR sweeps."""
 from __future__ import annotations
 
+from dataclasses import replace
 from types import SimpleNamespace
 
 import numpy as np
@@ -82,3 +83,31 @@ def test_a_flying_robot_keeps_frontiers_but_plans_no_observers(tunnel, tunnel_po
     st = csiro_state(ctx)
     assert len(st.frontiers.frontiers) >= 2 and not st.summaries
     assert not st.topometric.trajectory_nodes()
+
+
+def test_at_its_goal_the_robot_looks_again_and_an_unchanged_frontier_gets_a_better_observer(tunnel,
+                                                                                             tunnel_points):
+    grid, a, _ = tunnel
+    robot = FakeRobot(grid, body(a, 18.0))
+    ctx = make_ctx(robot)
+    node = UpdateFrontiers("update", ctx)
+    sweep(robot, tunnel_points)
+    node.tick_once()
+    st = csiro_state(ctx)
+    key, good = next((s.key, s) for s in st.own_summaries("r1"))
+    st.summaries[key] = replace(good, observer=good.observer - [20.0, 0, 0], reward=0.01)   # from a poor view
+    calls, kept = [], st.frontiers.frontiers
+    update = st.frontiers.update                                  # the view changes nothing of the frontiers
+    st.frontiers.update = lambda *args: calls.append(args[0]) or replace(update(*args), frontiers=kept,
+                                                                         new_ids=(), removed_ids=())
+    ctx.clock.now_s += 1.0
+    sweep(robot, tunnel_points)
+    node.tick_once()                                              # standing still: no update due
+    assert not calls
+    st.look_due = True                                            # FollowFrontierGoal reached its goal
+    sweep(robot, tunnel_points)
+    node.tick_once()
+    assert calls and not st.look_due
+    better = st.summaries[key]
+    assert better.reward > 0.01 and better.updated_s == good.updated_s   # no update of the frontier itself
+    assert np.linalg.norm(better.observer - good.observer) < 1.0
