@@ -86,7 +86,7 @@ class SelectUavFrontier(_Select):
     """Equation 16 for a flying robot, over its own frontiers: size, z-weighted distance and
     momentum, none smaller than the size limit, blacklisted or complete. Its goal is the place
     of the navigation graph it can reach that lies nearest the frontier's centre. A frontier
-    whose centre lies behind rock of the onboard map seen from that place (a patch of its blind
+    that lies wholly behind rock of the onboard map seen from that place (a patch of its blind
     cones beyond a roof or floor it had not sampled densely) is blacklisted at once
     (``csiro_frontier_behind_surface``) and the next one taken.
 
@@ -104,7 +104,7 @@ class SelectUavFrontier(_Select):
                 return self.none_left()
             frontier, momentum = picked
             near = reachable_near(self.ctx, r, frontier.mean)
-            if in_sight(r.onboard_map, r.position if near is None else near[1], frontier.mean):
+            if in_sight(r.onboard_map, r.position if near is None else near[1], frontier.points):
                 break
             st.blacklist.add(frontier.id)
             self.event("csiro_frontier_behind_surface", id=frontier.id, centre=xyz(frontier.mean, 2))
@@ -113,11 +113,11 @@ class SelectUavFrontier(_Select):
                            area_m2=round(frontier.area, 2))
 
 
-def in_sight(voxel_map: Any, eye: np.ndarray, point: np.ndarray) -> bool:
-    """Whether the straight line from ``eye`` to ``point`` crosses no occupied voxel of
-    ``voxel_map`` (but those next to ``point``'s)."""
-    ijk = np.floor((np.asarray(point, float) - voxel_map.origin) / voxel_map.voxel_size_m).astype(np.int64)
-    return bool(line_of_sight(voxel_map, eye, ijk[None])[0])
+def in_sight(voxel_map: Any, eye: np.ndarray, points: np.ndarray) -> bool:
+    """Whether the straight line from ``eye`` to at least one of ``points`` (K, 3) crosses no
+    occupied voxel of ``voxel_map`` (but those next to that point's)."""
+    ijk = np.floor((np.asarray(points, float).reshape(-1, 3) - voxel_map.origin) / voxel_map.voxel_size_m)
+    return bool(line_of_sight(voxel_map, eye, ijk.astype(np.int64)).any())
 
 
 __all__ = ["SelectUavFrontier", "SelectUgvFrontier"]

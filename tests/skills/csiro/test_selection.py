@@ -2,6 +2,8 @@
 distance (equation 15, Algorithm 3) and the flying robot's by equation 16."""
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 from delve.planners.csiro.frontier_types import Frontier
 from delve.planners.csiro.sharing import FrontierSummary
@@ -99,7 +101,7 @@ def test_uav_flies_for_its_own_frontier_and_skips_blacklisted_ones(tunnel, tunne
     assert node.status == Status.SUCCESS and bb("csiro_goal") != first
 
 
-def test_uav_blacklists_a_frontier_whose_centre_lies_behind_mapped_rock(tunnel, tunnel_points):
+def test_uav_blacklists_a_frontier_wholly_behind_mapped_rock(tunnel, tunnel_points):
     grid, a, _ = tunnel
     robot = FakeRobot(grid, a + np.array([18.0, 0.0, 1.5]), platform="aerial")
     ctx = make_ctx(robot)
@@ -115,3 +117,10 @@ def test_uav_blacklists_a_frontier_whose_centre_lies_behind_mapped_rock(tunnel, 
     node.tick_once()
     assert node.status == Status.SUCCESS and bb("csiro_goal")[1] != 99 and 99 in st.blacklist
     assert events(ctx, "csiro_frontier_behind_surface")[0]["id"] == 99
+    inside = a + np.array([18.0, 1.0, 1.5])                   # one of its triangles in the drift: in sight
+    st.blacklist.clear()
+    st.momentum = None                                         # no pull towards the frontier taken instead
+    st.frontiers._frontiers[99] = replace(big, points=np.array([beyond, inside]),
+                                          normals=np.array([[0, 1.0, 0]] * 2), areas=np.array([20.0, 5.0]))
+    node.tick_once()
+    assert bb("csiro_goal")[1] == 99 and 99 not in st.blacklist
