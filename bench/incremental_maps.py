@@ -80,8 +80,8 @@ def instrument_cops() -> None:
     def wrapper(self, grid, changed=None, *, standable=None, visited=None, prior=None, keep=()):
         topo = timed("COPS extraction, incremental", incremental, self, grid, changed, standable=standable,
                      visited=visited, prior=prior, keep=keep)
-        full = timed("COPS extraction, whole map", whole_map_extraction, self, grid, standable, visited=visited,
-                     prior=prior, keep=keep)
+        full = timed("COPS extraction, whole map", whole_map_extraction, self, grid, standable,
+                     visited=visited, prior=prior, keep=keep)
         if topo != full:
             MISMATCHES.append(f"COPS extraction {len(TIMES['COPS extraction, incremental'])}")
         return topo

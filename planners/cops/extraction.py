@@ -144,7 +144,8 @@ def extract_topology(
     lattice = _unpack(location_keys, partition)
     members = (location_of[component] >= 0) & stands
     world = grid.to_world(ijk[members])
-    positions = world[_position_voxels(world, location_of[component[members]], corner + (lattice + 0.5) * cell_m)]
+    centres = corner + (lattice + 0.5) * cell_m
+    positions = world[_position_voxels(world, location_of[component[members]], centres)]
     explored = ~np.isin(location_keys, _frontier_cell_keys(grid, partition))
     explored |= [tuple(c) in visited_cells for c in lattice.tolist()]
     mobility = _mobility_pairs(_touching_components(labels, partition), location_of)
@@ -153,13 +154,15 @@ def extract_topology(
         loc = location_of[open_faces(labels, partition, open_space(mask | passable_mask, grid.voxel_size_m,
                                                                    open_radius_m))]
         opened = loc[np.all(loc >= 0, axis=1)]
-    return _network(grid, lattice, positions, explored, mobility, opened, cell_m=cell_m, comm_range_m=comm_range_m,
-                    sight_height_m=sight_height_m, max_region_m=max_region_m, prior=prior, keep=keep)
+    return _network(grid, lattice, positions, explored, mobility, opened, cell_m=cell_m,
+                    comm_range_m=comm_range_m, sight_height_m=sight_height_m, max_region_m=max_region_m,
+                    prior=prior, keep=keep)
 
 
-def _network(grid: Grid, lattice: np.ndarray, positions: np.ndarray, explored: np.ndarray, mobility: np.ndarray,
-             opened: np.ndarray | None, *, cell_m: float, comm_range_m: float, sight_height_m: float,
-             max_region_m: float, prior: dict[str, str] | None, keep: tuple[str, ...] | list[str]) -> Topology:
+def _network(grid: Grid, lattice: np.ndarray, positions: np.ndarray, explored: np.ndarray,
+             mobility: np.ndarray, opened: np.ndarray | None, *, cell_m: float, comm_range_m: float,
+             sight_height_m: float, max_region_m: float, prior: dict[str, str] | None,
+             keep: tuple[str, ...] | list[str]) -> Topology:
     """The topology of the locations of lattice cells ``lattice`` (L, 3), in the cells'
     order, with their ``positions`` (L, 3), ``explored`` flags (L,), ``mobility`` pairs
     (E, 2) of locations, and ``opened`` pairs of locations open to each other (None:

@@ -95,7 +95,8 @@ class ExtractionUpdater:
 
     def __init__(self, *, cell_m: float = DEFAULT_CELL_M, comm_range_m: float = DEFAULT_COMM_RANGE_M,
                  min_free_voxels: int = DEFAULT_MIN_FREE_VOXELS, sight_height_m: float = 0.0,
-                 lattice_origin: np.ndarray | None = None, open_radius_m: float | None = DEFAULT_OPEN_RADIUS_M,
+                 lattice_origin: np.ndarray | None = None,
+                 open_radius_m: float | None = DEFAULT_OPEN_RADIUS_M,
                  max_region_m: float = DEFAULT_MAX_REGION_M):
         _check_parameters(cell_m, comm_range_m, min_free_voxels, sight_height_m, open_radius_m, max_region_m)
         self.cell_m, self.comm_range_m, self.min_free_voxels = cell_m, comm_range_m, min_free_voxels
@@ -179,9 +180,9 @@ class ExtractionUpdater:
         return extract_topology(grid.occupancy, grid.origin, grid.voxel_size_m, standable=mask,
                                 passable=grid.occupancy == FREE, free=grid.free, cell_m=self.cell_m,
                                 comm_range_m=self.comm_range_m, min_free_voxels=self.min_free_voxels,
-                                sight_height_m=self.sight_height_m, visited=visited, lattice_origin=self.corner,
-                                open_radius_m=self.open_radius_m, max_region_m=self.max_region_m,
-                                prior=prior, keep=keep)
+                                sight_height_m=self.sight_height_m, visited=visited,
+                                lattice_origin=self.corner, open_radius_m=self.open_radius_m,
+                                max_region_m=self.max_region_m, prior=prior, keep=keep)
 
     def _set_standable(self, flat: np.ndarray) -> np.ndarray:
         """Store the standable voxels ``flat`` (distinct); the voxels that became or
@@ -198,7 +199,8 @@ class ExtractionUpdater:
     def _cells_of(self, flat: np.ndarray) -> list[tuple[int, int, int]]:
         """The distinct lattice cells (in lattice order) of the voxels ``flat``."""
         ijk = np.unravel_index(flat, self._key[0])
-        keys = np.unique(_pack(np.stack([p[i] for p, i in zip(self._partition, ijk)], axis=1), self._partition))
+        cells = np.stack([p[i] for p, i in zip(self._partition, ijk)], axis=1)
+        keys = np.unique(_pack(cells, self._partition))
         return [tuple(c) for c in _unpack(keys, self._partition).tolist()]
 
     def _cell_box(self, cell: tuple[int, int, int]) -> tuple[slice, ...]:
@@ -240,7 +242,8 @@ class ExtractionUpdater:
         spot = at[_position_voxels(world, np.zeros(len(at), np.int64), centre[None])[0]]
         return _Cell(free_box, ids, int(ids[best]), spot)
 
-    def _touching_pairs(self, grid: Grid, gone: np.ndarray, labelled: list[tuple[int, int, int]]) -> np.ndarray:
+    def _touching_pairs(self, grid: Grid, gone: np.ndarray,
+                        labelled: list[tuple[int, int, int]]) -> np.ndarray:
         """The touching pairs of components (sorted rows, as ``_touching_components``):
         those kept (of neither ``gone`` component) and those of the voxels on the
         boundaries of the ``labelled`` cells with their 26 neighbours."""
@@ -270,9 +273,9 @@ class ExtractionUpdater:
         if not free.all():
             self._probed[around(flipped[~free], shape, self._probed_by)] = 0
         came = Voxels(grid.free_voxels() if first else flipped[free], shape)
-        test = []
+        test, step = [], [shape[1] * shape[2], shape[2], 1]
         for d in [(0, 0, 0)] if first else self._probed_by:   # the voxels whose probe a freed voxel is
-            test.append(came.flat[came.at(occ, d, OCCUPIED) == FREE] + np.dot(d, [shape[1] * shape[2], shape[2], 1]))
+            test.append(came.flat[came.at(occ, d, OCCUPIED) == FREE] + int(np.dot(d, step)))
         v = Voxels(np.concatenate(test), shape)
         idx = np.arange(len(v.flat))
         for d in self._probes:
@@ -292,8 +295,8 @@ class ExtractionUpdater:
         ijk = np.stack(np.unravel_index(self._probed_flat, grid.shape), axis=1)
         reach = math.ceil(self.open_radius_m / grid.voxel_size_m) + 1
         lo, hi = ijk.min(axis=0), ijk.max(axis=0) + 1
-        box = tuple(slice(max(0, int(lo[a]) - reach), min(n, int(hi[a]) + reach)) for a, n in enumerate(grid.shape[:2]))
-        box += (slice(int(lo[2]), int(hi[2])),)
+        box = tuple(slice(max(0, int(lo[a]) - reach), min(n, int(hi[a]) + reach))
+                    for a, n in enumerate(grid.shape[:2])) + (slice(int(lo[2]), int(hi[2])),)
         at = np.stack(np.unravel_index(flipped, grid.shape), axis=1)
         inside = np.all((at >= [s.start for s in box]) & (at < [s.stop for s in box]), axis=1)
         if box != self._open_box or inside.any():

@@ -237,7 +237,8 @@ class VoxelNetworkView:
             grid = self.navigator.grid()
             self._topology = self._extractor.update(
                 grid, self._changes(), standable=self.standable(grid, graph),
-                visited=self._cell_centres(self._visited), prior=self._topology.merged, keep=(self.base_cell,))
+                visited=self._cell_centres(self._visited), prior=self._topology.merged,
+                keep=(self.base_cell,))
             self._graph = graph
             self.extractions += 1
         visited = {self._topology.resolve(c) for c in self._visited}

@@ -63,7 +63,8 @@ def test_changes_gathered_over_several_sweeps_and_a_cleared_sphere_give_the_full
     for i, (m, changed) in enumerate(sweeps(mine(), walk(mine())[:40])):
         pending.append(changed)
         if i == 25:   # a local map reset, as after a fault: the ball around the robot is unknown again
-            centre = m.origin + (np.array(np.unravel_index(m.free_voxels()[-1], m.shape)) + 0.5) * m.voxel_size_m
+            last = np.array(np.unravel_index(m.free_voxels()[-1], m.shape))
+            centre = m.origin + (last + 0.5) * m.voxel_size_m
             log = m.change_log()
             m.set_sphere(centre, 3.0, -1)
             pending.append(log.take())
@@ -147,10 +148,11 @@ def test_a_change_of_the_standable_voxels_alone_is_followed():
     fewer = stand[~((x >= 32) & (x < 40) & (y >= 24) & (y < 40))]      # half of cell (2, 0, 0)'s floor
     got = updater.update(grid, np.zeros(0, np.int64), standable=fewer)
     assert got == full(grid, fewer, **params)
-    assert got.merged == whole.merged and got.locations[got.resolve("c2_0_0")] != whole.locations[whole.resolve("c2_0_0")]
+    assert got.merged == whole.merged                       # the room's region, its position moved
+    assert got.locations[got.resolve("c2_0_0")] != whole.locations[whole.resolve("c2_0_0")]
 
 
-def test_where_a_layer_would_fall_in_another_cell_counted_from_the_crop_the_update_is_the_full_one(monkeypatch):
+def test_where_a_layer_falls_in_another_cell_counted_from_the_crop_the_update_is_the_full_one(monkeypatch):
     occ = room()
     grid = Grid(occ, np.zeros(3), V)
     params = dict(cell_m=CELL_M, lattice_origin=ROOM_CORNER)
