@@ -311,8 +311,7 @@ def _cropped(grid: Grid) -> tuple[Grid, tuple[slice, ...]]:
         return grid, tuple(slice(0, n) for n in grid.shape)
     ijk = np.unravel_index(free, grid.shape)
     sub, box = _crop(grid, [int(a.min()) for a in ijk], [int(a.max()) for a in ijk])
-    shape = sub.shape
-    sub_free = np.ravel_multi_index(tuple(a - b.start for a, b in zip(ijk, box)), shape)
+    sub_free = np.ravel_multi_index(tuple(a - b.start for a, b in zip(ijk, box)), sub.shape)
     return Grid(sub.occupancy, sub.origin, sub.voxel_size_m, np.sort(sub_free)), box
 
 

@@ -90,9 +90,6 @@ class VoxelNetworkView:
         self.robot = robot
         self.lattice_origin = np.zeros(3) if lattice_origin is None else np.asarray(lattice_origin, float)
         self.cell_m = float(cell_m)
-        self.comm_range_m = float(comm_range_m)
-        self.min_free_voxels = min_free_voxels
-        self.open_radius_m, self.max_region_m = open_radius_m, max_region_m
         #: The base's cell, never merged into a region.
         self.base_cell = cell_name((0, 0, 0))
         self.navigator = navigator if navigator is not None else Navigator(
@@ -103,7 +100,7 @@ class VoxelNetworkView:
         self._trail_seen = 0
         self.extractions = 0
         self._extractor = ExtractionUpdater(
-            cell_m=self.cell_m, comm_range_m=self.comm_range_m, min_free_voxels=min_free_voxels,
+            cell_m=self.cell_m, comm_range_m=float(comm_range_m), min_free_voxels=min_free_voxels,
             sight_height_m=self.sight_height_m(), lattice_origin=self.lattice_origin,
             open_radius_m=open_radius_m, max_region_m=max_region_m)
         #: The map the extractor follows and its change log.
