@@ -9,6 +9,7 @@ import numpy as np
 from py_trees.common import Status
 from py_trees.ports import PortInformation
 
+from ...planners.csiro.params import CsiroFrontierParams
 from ...planners.csiro.selection import select_uav_frontier, select_ugv_frontier
 from ...planners.csiro.topometric import frontier_node
 from ...planners.geometry import xyz
@@ -86,9 +87,9 @@ class SelectUavFrontier(_Select):
     """Equation 16 for a flying robot, over its own frontiers: size, z-weighted distance and
     momentum, none smaller than the size limit, blacklisted or complete. Its goal is the place
     of the navigation graph it can reach that lies nearest the frontier's centre. A frontier
-    that lies wholly behind rock of the onboard map seen from that place (a patch of its blind
-    cones beyond a roof or floor it had not sampled densely) is blacklisted at once
-    (``csiro_frontier_behind_surface``) and the next one taken.
+    that lies wholly in its sensor's blind cones and behind rock of the onboard map seen from
+    that place (a patch beyond a roof or floor whose cached points left gaps) is blacklisted at
+    once (``csiro_frontier_behind_surface``) and the next one taken.
 
     Writes ``goal`` and ``csiro_goal``. Returns SUCCESS with a goal; RUNNING while none is
     selectable, up to ``wait_s``; then FAILURE (exploration over).
@@ -104,13 +105,22 @@ class SelectUavFrontier(_Select):
                 return self.none_left()
             frontier, momentum = picked
             near = reachable_near(self.ctx, r, frontier.mean)
-            if in_sight(r.onboard_map, r.position if near is None else near[1], frontier.points):
+            place = r.position if near is None else near[1]
+            if in_view(frontier.points - place, st.frontier_params).any() or \
+                    in_sight(r.onboard_map, place, frontier.points):
                 break
             st.blacklist.add(frontier.id)
             self.event("csiro_frontier_behind_surface", id=frontier.id, centre=xyz(frontier.mean, 2))
         st.momentum = momentum
         return self.chosen((name, frontier.id), frontier.mean if near is None else near[1],
                            area_m2=round(frontier.area, 2))
+
+
+def in_view(directions: np.ndarray, params: CsiroFrontierParams) -> np.ndarray:
+    """(K,) bool: whether each of ``directions`` (K, 3) lies within the sensor's elevations."""
+    d = np.asarray(directions, float).reshape(-1, 3)
+    elevation = np.degrees(np.arctan2(d[:, 2], np.linalg.norm(d[:, :2], axis=1)))
+    return (elevation >= params.elevation_min_deg) & (elevation <= params.elevation_max_deg)
 
 
 def in_sight(voxel_map: Any, eye: np.ndarray, points: np.ndarray) -> bool:

@@ -101,15 +101,15 @@ def test_uav_flies_for_its_own_frontier_and_skips_blacklisted_ones(tunnel, tunne
     assert node.status == Status.SUCCESS and bb("csiro_goal") != first
 
 
-def test_uav_blacklists_a_frontier_wholly_behind_mapped_rock(tunnel, tunnel_points):
+def test_uav_blacklists_a_frontier_wholly_in_its_blind_cones_behind_mapped_rock(tunnel, tunnel_points):
     grid, a, _ = tunnel
     robot = FakeRobot(grid, a + np.array([18.0, 0.0, 1.5]), platform="aerial")
     ctx = make_ctx(robot)
     sweep(robot, tunnel_points)
     UpdateFrontiers("update", ctx).tick_once()
     st = csiro_state(ctx)
-    beyond = a + np.array([18.0, 5.0, 1.5])                  # 5 m aside, through the tunnel's wall
-    assert grid.value_at(a[None] + [[18.0, 2.1, 1.5]])[0] == OCCUPIED
+    beyond = a + np.array([18.0, 0.0, 5.0])                  # straight up (blind), through the roof
+    assert grid.value_at(a[None] + [[18.0, 0.0, 3.1]])[0] == OCCUPIED
     big = Frontier(id=99, points=beyond[None], normals=np.array([[0.0, 0.0, 1.0]]), areas=np.array([25.0]),
                    mean=beyond, cov=np.diag([4.0, 4.0, 0.01]))
     st.frontiers._frontiers[99] = big                          # the largest, nearest: eq. 16 would take it
@@ -117,7 +117,7 @@ def test_uav_blacklists_a_frontier_wholly_behind_mapped_rock(tunnel, tunnel_poin
     node.tick_once()
     assert node.status == Status.SUCCESS and bb("csiro_goal")[1] != 99 and 99 in st.blacklist
     assert events(ctx, "csiro_frontier_behind_surface")[0]["id"] == 99
-    inside = a + np.array([18.0, 1.0, 1.5])                   # one of its triangles in the drift: in sight
+    inside = a + np.array([18.0, 1.0, 2.5])                   # one of its triangles in the drift: in view
     st.blacklist.clear()
     st.momentum = None                                         # no pull towards the frontier taken instead
     st.frontiers._frontiers[99] = replace(big, points=np.array([beyond, inside]),
