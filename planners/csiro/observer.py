@@ -150,6 +150,14 @@ def _candidate_graph(positions: np.ndarray, pairs: np.ndarray) -> nx.Graph:
 ALL_ELEVATIONS_DEG = (-90.0, 90.0)
 
 
+def within_elevations(directions: np.ndarray, elevations_deg: tuple[float, float]) -> np.ndarray:
+    """Bool mask over ``directions`` (..., 3): whether each lies within the sensor's
+    ``elevations_deg`` (min, max) above the horizontal."""
+    d = np.asarray(directions, float)
+    elevation = np.degrees(np.arctan2(d[..., 2], np.linalg.norm(d[..., :2], axis=-1)))
+    return (elevation >= elevations_deg[0]) & (elevation <= elevations_deg[1])
+
+
 def observation_rewards(candidates: np.ndarray, frontier: Frontier, d_max_m: float,
                         params: CsiroSelectionParams, *, sensor_height_m: float = 0.0,
                         elevations_deg: tuple[float, float] = ALL_ELEVATIONS_DEG) -> np.ndarray:
@@ -164,8 +172,7 @@ def observation_rewards(candidates: np.ndarray, frontier: Frontier, d_max_m: flo
     view = frontier.points[None, :, :] - sensors[:, None, :]
     distance = np.linalg.norm(view, axis=2)
     cos_plus = np.maximum(np.einsum("nkj,kj->nk", view, frontier.normals) / np.maximum(distance, 1e-12), 0.0)
-    elevation = np.degrees(np.arctan2(view[:, :, 2], np.linalg.norm(view[:, :, :2], axis=2)))
-    cos_plus[(elevation < elevations_deg[0]) | (elevation > elevations_deg[1])] = 0.0
+    cos_plus[~within_elevations(view, elevations_deg)] = 0.0
     r = np.maximum(distance, params.reward_min_range_m)
     reach = d_max_m ** 2 / r if params.reduced_dynamic_range else d_max_m ** 3 / r ** 2
     return frontier.areas[None, :] * cos_plus / 3.0 * np.maximum(reach - r, 0.0)

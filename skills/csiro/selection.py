@@ -9,10 +9,11 @@ import numpy as np
 from py_trees.common import Status
 from py_trees.ports import PortInformation
 
-from ...planners.csiro.params import CsiroFrontierParams
+from ...planners.csiro.observer import within_elevations
 from ...planners.csiro.selection import select_uav_frontier, select_ugv_frontier
 from ...planners.csiro.topometric import frontier_node
 from ...planners.geometry import xyz
+from ...planners.occupancy import Grid
 from ...planners.visibility import line_of_sight
 from ..base import Param, Skill
 from .follow import reachable_near
@@ -106,7 +107,8 @@ class SelectUavFrontier(_Select):
             frontier, momentum = picked
             near = reachable_near(self.ctx, r, frontier.mean)
             place = r.position if near is None else near[1]
-            if in_view(frontier.points - place, st.frontier_params).any() or \
+            fp = st.frontier_params
+            if within_elevations(frontier.points - place, (fp.elevation_min_deg, fp.elevation_max_deg)).any() or \
                     in_sight(r.onboard_map, place, frontier.points):
                 break
             st.blacklist.add(frontier.id)
@@ -116,18 +118,11 @@ class SelectUavFrontier(_Select):
                            area_m2=round(frontier.area, 2))
 
 
-def in_view(directions: np.ndarray, params: CsiroFrontierParams) -> np.ndarray:
-    """(K,) bool: whether each of ``directions`` (K, 3) lies within the sensor's elevations."""
-    d = np.asarray(directions, float).reshape(-1, 3)
-    elevation = np.degrees(np.arctan2(d[:, 2], np.linalg.norm(d[:, :2], axis=1)))
-    return (elevation >= params.elevation_min_deg) & (elevation <= params.elevation_max_deg)
-
-
 def in_sight(voxel_map: Any, eye: np.ndarray, points: np.ndarray) -> bool:
     """Whether the straight line from ``eye`` to at least one of ``points`` (K, 3) crosses no
     occupied voxel of ``voxel_map`` (but those next to that point's)."""
-    ijk = np.floor((np.asarray(points, float).reshape(-1, 3) - voxel_map.origin) / voxel_map.voxel_size_m)
-    return bool(line_of_sight(voxel_map, eye, ijk.astype(np.int64)).any())
+    ijk = Grid(voxel_map.occupancy, voxel_map.origin, voxel_map.voxel_size_m).to_index(np.reshape(points, (-1, 3)))
+    return bool(line_of_sight(voxel_map, eye, ijk).any())
 
 
 __all__ = ["SelectUavFrontier", "SelectUgvFrontier"]
