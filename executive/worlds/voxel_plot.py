@@ -76,7 +76,7 @@ def plot_voxel_map(mission: "Mission", truth_voxels: np.ndarray, path: Path) -> 
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
     ax.set_title(f"{mission.scenario.name}: team coverage {mission.state.samples[-1].team:.0%}")
-    ax.legend(loc="upper right", fontsize=7)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    # Beside the map, not on it: with a team's many entries it hid part of the world.
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0, fontsize=7)
+    fig.savefig(path, dpi=110, bbox_inches="tight")
     plt.close(fig)
