@@ -12,6 +12,9 @@ sight from every reachable viewpoint, which is too slow for every planning step.
 
 from __future__ import annotations
 
+import functools
+import itertools
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -20,7 +23,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
-from .navgraph import FACES, NavGraph, Voxels
+from .navgraph import FACES, NavGraph, Voxels, _Lookup
 from .occupancy import FREE, OCCUPIED, UNKNOWN, Grid
 
 
@@ -93,6 +96,11 @@ VIEWPOINTS_PER_VOXEL = 128
 MAX_GOAL_OFFSET_M = 12.0
 
 
+#: Cells (of the bounding box of the nodes) up to which viewpoint_nodes finds each one's
+#: first node with a table rather than by sorting.
+_MAX_CELL_TABLE = 1 << 26
+
+
 def viewpoint_nodes(graph: NavGraph, distances: np.ndarray,
                     spacing_m: float = VIEWPOINT_SPACING_M) -> np.ndarray:
     """The nodes reachable from the robot (finite ``distances``), thinned to the first of
@@ -100,11 +108,19 @@ def viewpoint_nodes(graph: NavGraph, distances: np.ndarray,
     reachable = np.flatnonzero(np.isfinite(distances))
     if len(reachable) == 0:
         return reachable
-    cell = np.floor(graph.positions[reachable] / spacing_m).astype(np.int64)
-    cell -= cell.min(axis=0)
-    span = cell.max(axis=0) + 1
-    _, first = np.unique((cell[:, 0] * span[1] + cell[:, 1]) * span[2] + cell[:, 2], return_index=True)
-    return reachable[np.sort(first)]
+    key = np.zeros(len(reachable), dtype=np.int64)
+    for a in range(3):   # one contiguous coordinate at a time
+        cell = np.floor(graph.positions[reachable, a] / spacing_m).astype(np.int64)
+        cell -= cell.min()
+        key = key * (int(cell.max()) + 1) + cell
+    if key.max() >= _MAX_CELL_TABLE:
+        _, first = np.unique(key, return_index=True)
+        return reachable[np.sort(first)]
+    # The first node of each cell: written last in a reversed scatter (as navgraph.distinct).
+    first = np.empty(int(key.max()) + 1, dtype=np.int32)
+    at = np.arange(len(key), dtype=np.int32)
+    first[key[::-1]] = at[::-1]
+    return reachable[first[key] == at]
 
 
 def in_view(sensor: np.ndarray, points: np.ndarray, view_up_deg: float, slack_m: float) -> np.ndarray:
@@ -151,6 +167,25 @@ def observes(sensor: np.ndarray, points: np.ndarray, normals: np.ndarray, view_u
     return (dist <= reach_m) & facing & below_top
 
 
+def observes_samples(sensors: np.ndarray, points: np.ndarray, normals: np.ndarray, sample: np.ndarray,
+                     view_up_deg: float, reach_m: float, slack_m: float) -> np.ndarray:
+    """``observes(sensors[:, None], points[sample], normals[sample], ...)`` (C, S) for
+    sensors (C, 3) and view targets (:func:`view_targets`, whose normals are face
+    directions or zero) picked by ``sample`` (C, S), the same values: per coordinate
+    on contiguous arrays, and the dot product with a face direction as the one
+    coordinate it picks (exact), so no (C, S, 3) arrays are gathered."""
+    px, py, pz = (np.ascontiguousarray(points[:, a])[sample] for a in range(3))
+    dx, dy, dz = px - sensors[:, 0, None], py - sensors[:, 1, None], pz - sensors[:, 2, None]
+    level = np.hypot(dx, dy)
+    dist = np.hypot(level, dz)
+    nx, ny, nz = (np.ascontiguousarray(normals[:, a])[sample] for a in range(3))
+    dot = dx * nx + dy * ny + dz * nz   # one term at most is nonzero: exact
+    cos_max = np.cos(np.radians(MAX_INCIDENCE_DEG))
+    facing = (dot >= cos_max * dist) | ((nx == 0) & (ny == 0) & (nz == 0))
+    below_top = dz <= level * np.tan(np.radians(min(view_up_deg, 89.9))) + slack_m
+    return (dist <= reach_m) & facing & below_top
+
+
 def clear_sight(grid: Grid, a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Whether each segment ``a[i]``-``b[i]`` crosses no OCCUPIED voxel of the map and
     stays inside it (sampled every half voxel up to its end). Unknown voxels do not
@@ -162,12 +197,12 @@ def clear_sight(grid: Grid, a: np.ndarray, b: np.ndarray) -> np.ndarray:
     t = (np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n)) / n[seg]
     pts = a[seg] + (b - a)[seg] * t[:, None]
     idx = grid.to_index(pts)
-    inside = grid.in_bounds(idx)
-    occ = np.full(len(pts), OCCUPIED, dtype=np.int8)
-    occ[inside] = grid.occupancy[idx[inside, 0], idx[inside, 1], idx[inside, 2]]
-    blocked = np.zeros(len(a), dtype=bool)
-    np.logical_or.at(blocked, seg, occ == OCCUPIED)
-    return ~blocked
+    nx, ny, nz = grid.shape
+    i, j, k = idx[:, 0], idx[:, 1], idx[:, 2]
+    inside = (i >= 0) & (i < nx) & (j >= 0) & (j < ny) & (k >= 0) & (k < nz)
+    flat = np.where(inside, (i * ny + j) * nz + k, 0)
+    rock = ~inside | (grid.occupancy.reshape(-1)[flat] == OCCUPIED)
+    return np.bincount(seg[rock], minlength=len(a)) == 0
 
 
 def observable_frontiers(grid: Grid, voxels: np.ndarray, viewpoints: np.ndarray, *, view_up_deg: float,
@@ -230,9 +265,8 @@ def frontier_clusters(grid: Grid, voxels: np.ndarray, *, cluster_radius_m: float
     packed, block_of = np.unique((b[:, 0] * nb[1] + b[:, 1]) * nb[2] + b[:, 2], return_inverse=True)
     blocks = np.stack(np.unravel_index(packed, tuple(nb)), axis=1)
     centres = grid.origin + (blocks * 2 + 1.0) * grid.voxel_size_m
-    # An unbalanced tree builds faster and finds the same pairs (components ignore their order).
-    pairs = cKDTree(centres, balanced_tree=False).query_pairs(cluster_radius_m, output_type="ndarray")
-    adj = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(len(blocks), len(blocks)))
+    src, dst = _close_blocks(packed, tuple(int(n) for n in nb), centres, cluster_radius_m, 2 * grid.voxel_size_m)
+    adj = coo_matrix((np.ones(len(src)), (src, dst)), shape=(len(blocks), len(blocks)))
     _, component = connected_components(adj, directed=False)
     cell = np.floor((centres - grid.origin) / max_extent_m).astype(np.int64)
     span = cell.max(axis=0) + 1
@@ -245,8 +279,42 @@ def frontier_clusters(grid: Grid, voxels: np.ndarray, *, cluster_radius_m: float
     clusters = []
     for c in np.flatnonzero(np.diff(bounds) >= min_cluster_voxels):
         members = order[bounds[c] : bounds[c + 1]]
-        clusters.append(FrontierCluster(voxels=voxels[members], centroid=pts[members].mean(axis=0)))
+        # np.mean's own sum and division, without its wrapper's cost (same values)
+        centroid = np.add.reduce(pts[members], axis=0) / len(members)
+        clusters.append(FrontierCluster(voxels=voxels[members], centroid=centroid))
     return clusters
+
+
+def _close_blocks(packed: np.ndarray, shape: tuple[int, int, int], centres: np.ndarray, radius_m: float,
+                  spacing_m: float) -> tuple[np.ndarray, np.ndarray]:
+    """Each pair (i, j) of blocks whose centres are at most ``radius_m`` apart, once: the
+    pairs ``cKDTree.query_pairs`` finds (squared distance summed axis by axis, compared
+    with the squared radius), found by looking up the few lattice offsets within reach
+    (blocks: ascending flat indices ``packed`` on a lattice of ``shape``, ``spacing_m``
+    apart, centres (N, 3))."""
+    src, dst = [np.zeros(0, dtype=np.int64)], [np.zeros(0, dtype=np.int64)]
+    q = Voxels(packed, shape)
+    r2 = radius_m * radius_m
+    with _Lookup(int(np.prod(shape)), packed) as ids:
+        for d in _lattice_offsets(radius_m, spacing_m):
+            j = q.at(ids, d, 0).astype(np.int64) - 1
+            i = np.flatnonzero(j >= 0)
+            j = j[i]
+            diff = centres[i] - centres[j]
+            near = (diff[:, 0] * diff[:, 0] + diff[:, 1] * diff[:, 1]) + diff[:, 2] * diff[:, 2] <= r2
+            src.append(i[near])
+            dst.append(j[near])
+    return np.concatenate(src), np.concatenate(dst)
+
+
+@functools.lru_cache(maxsize=16)
+def _lattice_offsets(radius_m: float, spacing_m: float) -> list[tuple[int, int, int]]:
+    """The offsets (one of each opposite pair) of a lattice ``spacing_m`` apart that may be
+    within ``radius_m`` (with a margin for rounding: the caller tests the distance)."""
+    reach = int(radius_m / spacing_m) + 1
+    span = range(-reach, reach + 1)
+    return [d for d in itertools.product(span, span, span)
+            if d > (0, 0, 0) and math.sqrt(d[0] ** 2 + d[1] ** 2 + d[2] ** 2) * spacing_m <= radius_m * (1 + 1e-6)]
 
 
 #: Voxels of each cluster whose view is checked from every goal candidate (bounds the work).
@@ -306,8 +374,7 @@ def nearest_frontier(
     cand = nodes[np.concatenate([np.asarray(n, dtype=np.int64) for n in near])]
     offset = np.linalg.norm(centroids[owner] - graph.positions[cand], axis=1)
     sensor = graph.positions[cand] + np.array([0.0, 0.0, sensor_height_m])
-    picks = [c.voxels[np.linspace(0, c.size - 1, min(c.size, VIEW_SAMPLES)).astype(np.int64)]
-             for c in clusters]
+    picks = [c.voxels[_view_samples(c.size)] for c in clusters]
     sizes = np.array([len(p) for p in picks])
     first = np.cumsum(sizes) - sizes
     points, normals = view_targets(grid, np.concatenate(picks))
@@ -315,7 +382,7 @@ def nearest_frontier(
     col = np.arange(sizes.max())
     sample = np.minimum(first[owner][:, None] + col, len(points) - 1)
     slack = 0.5 * grid.voxel_size_m
-    seen = observes(sensor[:, None, :], points[sample], normals[sample], view_up_deg, max_goal_offset_m, slack)
+    seen = observes_samples(sensor, points, normals, sample, view_up_deg, max_goal_offset_m, slack)
     share = (seen & (col < sizes[owner][:, None])).sum(axis=1) / sizes[owner]
     best = np.zeros(len(clusters))
     np.maximum.at(best, owner, share)
@@ -350,6 +417,14 @@ def nearest_frontier(
         if accept(goal):
             return goal
     return None
+
+
+@functools.lru_cache(maxsize=4096)
+def _view_samples(size: int) -> np.ndarray:
+    """Positions of the :data:`VIEW_SAMPLES` voxels (or all) spread over a cluster of ``size``."""
+    out = np.linspace(0, size - 1, min(size, VIEW_SAMPLES)).astype(np.int64)
+    out.flags.writeable = False
+    return out
 
 
 def _observed(grid: Grid, voxels: np.ndarray, sensor: np.ndarray, view_up_deg: float,

@@ -29,6 +29,8 @@ IDLE, FOLLOWING, ARRIVED, BLOCKED = "idle", "following", "arrived", "blocked"
 #: Range-sensor sweeps a robot keeps for ``take_lidar_scans`` (the oldest go first).
 LIDAR_SCANS_KEPT = 20
 _GOLDEN = (math.sqrt(5) - 1) / 2
+#: The direction of a ground probe.
+_DOWN = np.array([[0.0, 0.0, -1.0]])
 
 
 class SimRobot(RobotBody):
@@ -324,7 +326,7 @@ class SimRobot(RobotBody):
             if math.isnan(ground) or abs(ground - self._ground) > p.max_step_m + 1e-6:
                 return self._block("no ground or step too high")
             new = np.array([new[0], new[1], ground + p.body_height_m])
-            if not self.world.is_free(new[None])[0]:
+            if not self.world.is_free_at(float(new[0]), float(new[1]), float(new[2])):
                 return self._block("rock in the way")
             travelled = self._slope_hist[-1][0] + float(np.hypot(*(new[:2] - self._pos[:2])))
             hist = self._slope_hist + [(travelled, ground)]
@@ -351,9 +353,9 @@ class SimRobot(RobotBody):
         down onto the world mesh (continuous, unlike the voxel grid); NaN if none."""
         reach = self._platform.max_step_m + 0.3
         probe = np.array([[x, y, self._ground + reach]])
-        if not self.world.is_free(probe)[0]:
+        if not self.world.is_free_at(float(probe[0, 0]), float(probe[0, 1]), float(probe[0, 2])):
             return math.nan
-        d = float(self.world.cast_rays(probe, np.array([[0.0, 0.0, -1.0]]), 2 * reach)[0])
+        d = float(self.world.cast_rays(probe, _DOWN, 2 * reach)[0])
         return self._ground + reach - d if math.isfinite(d) else math.nan
 
     def _block(self, reason: str) -> bool:

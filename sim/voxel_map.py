@@ -123,11 +123,13 @@ class VoxelMap:
             inside = (i >= 0) & (i < nx) & (j >= 0) & (j < ny) & (k >= 0) & (k < nz)
         # Indices of samples outside the grid may wrap around in int32: they are dropped.
         flat = ((i * ny + j) * nz + k)[inside]
-        flat = (flat[occ[flat] == only] if only is not None else flat[occ[flat] != value]).astype(np.int64)
+        was = occ[flat]
+        keep = was == only if only is not None else was != value
+        flat, was = flat[keep].astype(np.int64), was[keep]
         if value == FREE:
             self._new_free.append(np.unique(flat))
-        else:
-            self._free_stale = True
+        elif (was == FREE).any():
+            self._free_stale = True   # voxels left FREE: the list of free voxels holds them
         occ[flat] = value
         self._touch(flat)
 

@@ -183,17 +183,23 @@ class World:
         """(N,) bool: which world points (N, 3) lie in free space (False outside the grid)."""
         p = np.asarray(points, dtype=float).reshape(-1, 3)
         if len(p) == 1 and np.isfinite(p).all():
-            # A robot's probes, two every sim step: the same arithmetic on plain
-            # floats is several times faster than on arrays of one point.
-            i = [math.floor((float(p[0, k]) - float(self.origin[k])) / self.voxel_size_m) for k in range(3)]
-            inside = all(0 <= i[k] < self.free.shape[k] for k in range(3))
-            return np.array([inside and bool(self.free[i[0], i[1], i[2]])])
+            return np.array([self.is_free_at(float(p[0, 0]), float(p[0, 1]), float(p[0, 2]))])
         idx = self.to_index(p)
         ok = self.in_bounds(idx)
         out = np.zeros(len(idx), dtype=bool)
         j = idx[ok]
         out[ok] = self.free[j[:, 0], j[:, 1], j[:, 2]]
         return out
+
+    def is_free_at(self, x: float, y: float, z: float) -> bool:
+        """Whether the point (x, y, z) lies in free space, as :meth:`is_free` of one point.
+        A robot's probes, two every sim step: the same arithmetic on plain floats is
+        several times faster than on arrays of one point."""
+        if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(z)):
+            return False
+        o, v, n = self.origin, self.voxel_size_m, self.free.shape
+        i, j, k = (math.floor((c - float(o[a])) / v) for a, c in enumerate((x, y, z)))
+        return 0 <= i < n[0] and 0 <= j < n[1] and 0 <= k < n[2] and bool(self.free[i, j, k])
 
     # ---------------------------------------------------------- ray casting
     @property
@@ -214,14 +220,16 @@ class World:
         Returns (N,) float32 distances, np.inf where nothing is hit within
         ``max_range_m``.
         """
-        o = np.asarray(origins, dtype=np.float32).reshape(-1, 3)
-        d = np.asarray(directions, dtype=np.float32).reshape(-1, 3)
+        o = np.asarray(origins).reshape(-1, 3)
+        d = np.asarray(directions).reshape(-1, 3)
         if len(o) != len(d):
             raise ValueError(f"{len(o)} origins but {len(d)} directions")
         if len(o) == 0:
             return np.zeros(0, dtype=np.float32)
-        rays = o3d.core.Tensor(np.ascontiguousarray(np.concatenate([o, d], axis=1)))
-        t = self.scene.cast_rays(rays)["t_hit"].numpy()
+        rays = np.empty((len(o), 6), dtype=np.float32)   # rounded to float32 as they are copied in
+        rays[:, :3] = o
+        rays[:, 3:] = d
+        t = self.scene.cast_rays(o3d.core.Tensor.from_numpy(rays))["t_hit"].numpy()
         t[~(t <= np.float32(max_range_m))] = np.inf
         return t
 

@@ -1,7 +1,11 @@
 import numpy as np
 
-from delve.planners.frontier import (frontier_clusters, frontier_voxels, nearest_frontier,
-                                    observable_frontiers, observes, view_targets, viewpoint_nodes)
+from scipy.spatial import cKDTree
+
+from delve.planners.frontier import (_close_blocks, clear_sight, frontier_clusters, frontier_voxels,
+                                    nearest_frontier, observable_frontiers, observes, observes_samples,
+                                    view_targets, viewpoint_nodes)
+from delve.planners.navgraph import NavGraph
 from delve.planners.navgraph import legged_graph
 from delve.planners.occupancy import FREE, OCCUPIED, UNKNOWN, Grid
 
@@ -135,3 +139,54 @@ def test_a_goal_behind_a_wall_is_passed_over_for_one_with_a_clear_line():
     assert goal.cluster.centroid[1] > 3.8
     assert g.positions[goal.node][1] > 3.8  # in the second drift
     assert len(goal.targets) >= 0.8 * goal.cluster.size
+
+
+def test_observes_samples_answers_as_observes_of_the_gathered_rows():
+    rng = np.random.default_rng(4)
+    points = rng.uniform(-15, 15, (60, 3))
+    faces = np.array([(1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0), (0, 0, 0)], float)
+    normals = faces[rng.integers(0, 5, len(points))]
+    sensors = rng.uniform(-15, 15, (300, 3))
+    sample = rng.integers(0, len(points), (300, 16))
+    for up in (15.0, 90.0):
+        want = observes(sensors[:, None, :], points[sample], normals[sample], up, 12.0, 0.1)
+        assert 0 < want.sum() < want.size
+        np.testing.assert_array_equal(observes_samples(sensors, points, normals, sample, up, 12.0, 0.1), want)
+
+
+def test_close_blocks_are_the_kd_tree_pairs_also_at_exactly_the_radius():
+    rng = np.random.default_rng(5)
+    shape = (30, 40, 20)
+    packed = np.unique(rng.integers(0, np.prod(shape), 4000))
+    blocks = np.stack(np.unravel_index(packed, shape), axis=1)
+    centres = np.array([-12.3, 4.05, 0.7]) + (blocks * 2 + 1.0) * 0.2
+    for radius in (0.8, 0.4 * np.sqrt(2), 0.5):   # 0.8 and 0.57 lie on lattice distances
+        want = cKDTree(centres).query_pairs(radius, output_type="ndarray")
+        i, j = _close_blocks(packed, shape, centres, radius, 0.4)
+        got = np.sort(np.minimum(i, j) * len(packed) + np.maximum(i, j))
+        assert len(want) > 0
+        np.testing.assert_array_equal(got, np.sort(want.min(axis=1) * len(packed) + want.max(axis=1)))
+
+
+def test_viewpoint_nodes_are_the_first_reachable_node_of_each_cell():
+    rng = np.random.default_rng(6)
+    pos = rng.uniform(-20, 20, (3000, 3))
+    dist = np.where(rng.random(len(pos)) < 0.7, 1.0, np.inf)
+    got = viewpoint_nodes(NavGraph(positions=pos, adjacency=None), dist, 1.2)
+    reachable = np.flatnonzero(np.isfinite(dist))
+    seen, want = set(), []
+    for n in reachable:
+        cell = tuple(np.floor(pos[n] / 1.2).astype(int))
+        if cell not in seen:
+            seen.add(cell)
+            want.append(n)
+    np.testing.assert_array_equal(got, want)
+
+
+def test_clear_sight_is_blocked_by_rock_and_by_leaving_the_grid():
+    occ = np.zeros((20, 10, 10), dtype=np.int8)
+    occ[10, :, :] = OCCUPIED
+    grid = Grid(occ, np.zeros(3), 0.2)
+    a = np.array([[0.5, 1.0, 1.0], [0.5, 1.0, 1.0], [0.5, 1.0, 1.0]])
+    b = np.array([[1.5, 1.0, 1.0], [3.5, 1.0, 1.0], [0.5, 1.0, 2.5]])   # clear, through rock, out of the grid
+    np.testing.assert_array_equal(clear_sight(grid, a, b), [True, False, False])

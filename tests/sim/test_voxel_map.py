@@ -148,3 +148,20 @@ def test_each_consumers_change_log_holds_scans_resets_and_merges_since_its_last_
     for log in (early, late):
         got = log.take()
         assert np.all(np.isin(changed, got)) and np.array_equal(got, np.unique(got))
+
+
+def test_the_free_list_is_filtered_again_only_when_a_free_voxel_turns_to_rock():
+    """A sweep whose hits fall only in unknown voxels leaves the list of free voxels as
+    it is; one that hits a free voxel drops just that voxel from the list."""
+    m = VoxelMap((20, 20, 20), np.zeros(3), 0.2)
+    sensor = np.array([0.5, 2.0, 2.0])
+    along_x = np.array([[1.0, 0.0, 0.0]])
+    m.integrate_scan(sensor, along_x, np.array([2.0]), 3.0)
+    m.integrate_scan(sensor, np.array([[0.0, 1.0, 0.0]]), np.array([1.0]), 3.0)
+    assert not m._free_stale   # rock where the map knew nothing
+    before = m.free_voxels().copy()
+    m.integrate_scan(sensor, along_x, np.array([1.0]), 3.0)   # rock inside the carved run
+    assert m._free_stale
+    hit = int(np.ravel_multi_index((7, 10, 10), m.shape))
+    assert hit in before and m.occupancy.reshape(-1)[hit] == OCCUPIED
+    np.testing.assert_array_equal(m.free_voxels(), before[before != hit])

@@ -73,6 +73,8 @@ def test_is_free_of_one_point_answers_as_for_many(twin):
     np.testing.assert_array_equal([twin.is_free(p[None])[0] for p in pts], many)
     with np.errstate(invalid="ignore"):  # NaN takes the array path, which casts it
         assert not twin.is_free(np.array([[np.nan, 0.0, 1.0]]))[0]
+    assert [twin.is_free_at(*map(float, p)) for p in pts] == many.tolist()
+    assert not twin.is_free_at(math.nan, 0.0, 1.0) and not twin.is_free_at(15.0, 0.0, math.inf)
 
 
 def test_rays_along_and_across_tunnel(twin):
