@@ -17,7 +17,15 @@ The runs are one sweep (``delve.executive.sweep``, docs/sweeps.md) on a Dask
 LocalCluster of ``--jobs`` workers (or the cluster at ``--scheduler``); ``--out DIR``
 keeps it, and a second start resumes it.
 
-    .venv/bin/python bench/team_exploration.py [--quick] [--seeds 1 2 3 4 5] [--methods ...] [--jobs 1] [--out DIR]
+    .venv/bin/python bench/team_exploration.py [--quick] [--seeds 1 2 3 4 5] [--methods ...] [--radio-range-m 60]
+        [--jobs 1] [--out DIR]
+
+``--radio-range-m`` sets the base station's radio range (default 60 m: with the link
+budget of ``sim/radio.py``, rock and corners cut it to the first tunnels).
+``--radio-clear`` lets links reach that range through rock (no obstruction loss and a
+20 dB margin at the range): with a range larger than the world (``--radio-clear
+--radio-range-m 1000``) every robot has a link everywhere, which shows what COHORT's
+coordination gains without its lost-link rule.
 
 Prints one row per run, then per world and method the median of: T90 (sim time to
 90 % of the world's free volume observed by the team; "not reached" counts as later
@@ -34,6 +42,7 @@ for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUME
     os.environ.setdefault(_var, "1")
 
 import argparse
+import math
 import shlex
 import statistics
 import sys
@@ -66,9 +75,12 @@ DURATION_S = 1800.0
 ARTIFACTS = 20
 #: The quick worlds hold fewer artifacts 10 m apart.
 QUICK_ARTIFACTS = 10
-#: The base station's radio reaches only part of the world (as in the COHORT paper).
+#: The base station's radio reaches only part of the world (as in the COHORT paper);
+#: ``--radio-range-m`` changes it.
 RADIO_RANGE_M = 60.0
 TARGET = "90%"
+#: ``--radio-clear``: the link margin at the range (dB).
+CLEAR_MARGIN_DB = 20.0
 
 
 @dataclass
@@ -92,10 +104,26 @@ def robots_section(method: str) -> list[dict]:
             for i in range(count)]
 
 
-def scenario_doc(world: dict, seed: int, duration_s: float, artifacts: int) -> dict:
+def radio_doc(range_m: float, clear: bool) -> dict:
+    """The scenario's radio section: the range alone (the link budget of ``sim/radio.py``
+    still applies), or with ``clear`` no obstruction loss and the transmit power that
+    leaves :data:`CLEAR_MARGIN_DB` at the range (log-distance path loss of RadioSpec)."""
+    if not clear:
+        return {"range_m": range_m}
+    from delve.sim.radio import RadioSpec
+
+    spec = RadioSpec()
+    path_loss = spec.path_loss_d0_db + 10.0 * spec.path_loss_exponent * math.log10(
+        max(range_m, spec.reference_distance_m) / spec.reference_distance_m)
+    return {"range_m": range_m, "corner_loss_db": 0.0, "rock_loss_db_per_m": 0.0,
+            "tx_power_dbm": round(spec.sensitivity_dbm + CLEAR_MARGIN_DB + path_loss, 1)}
+
+
+def scenario_doc(world: dict, seed: int, duration_s: float, artifacts: int,
+                 radio: dict | None = None) -> dict:
     """The scenario every run starts from (the sweep sets world, robots, base and team)."""
     return {"name": "team_exploration", "seed": seed, "duration_s": duration_s, "world": world,
-            "radio": {"range_m": RADIO_RANGE_M}, "artifacts": {"count": artifacts},
+            "radio": radio or {"range_m": RADIO_RANGE_M}, "artifacts": {"count": artifacts},
             "base_station": {"tree": str(TREES / "base_station.yaml")}, "robots": robots_section("single")}
 
 
@@ -120,11 +148,11 @@ def _number(row, column: str) -> float | None:
 
 
 def run_sweep(worlds: dict[str, dict], methods: list[str], seeds: list[int], duration_s: float, artifacts: int,
-              out: Path, jobs: int, scheduler: str | None) -> list[Run]:
+              out: Path, jobs: int, scheduler: str | None, radio: dict | None = None) -> list[Run]:
     """Run the sweep into ``out``; its finished rows as Runs (a failed run is printed and left out)."""
     from bench_sweep import run_bench_sweep
 
-    first = scenario_doc(next(iter(worlds.values())), seeds[0], duration_s, artifacts)
+    first = scenario_doc(next(iter(worlds.values())), seeds[0], duration_s, artifacts, radio)
     result = run_bench_sweep(out, first, sweep_doc(worlds, methods, seeds), jobs, scheduler)
     for r in result.table[result.table["status"] != "ok"].itertuples():
         print(f"FAILED {r.run_id}: {r.error}")
@@ -200,12 +228,19 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--worlds", nargs="+", choices=list(WORLDS), default=list(WORLDS))
     ap.add_argument("--methods", nargs="+", choices=list(METHODS), default=["single", "independent", "cohort", "csiro"])
     ap.add_argument("--duration-s", type=float, default=DURATION_S, help="mission limit (sim seconds)")
+    ap.add_argument("--radio-range-m", type=float, default=RADIO_RANGE_M,
+                    help=f"the base station's radio range (default {RADIO_RANGE_M:.0f} m)")
+    ap.add_argument("--radio-clear", action="store_true",
+                    help="links reach the range through rock (with --radio-range-m 1000: everywhere)")
     ap.add_argument("--jobs", type=int, default=1, help="workers of the local cluster (a team run needs ~2 GB)")
     ap.add_argument("--scheduler", metavar="ADDRESS", help="run the sweep on the Dask cluster at ADDRESS")
     ap.add_argument("--out", type=Path, help="keep the sweep in DIR (and resume it there); default: a temporary folder")
     args = ap.parse_args(argv)
+    if not args.radio_range_m > 0:
+        ap.error(f"--radio-range-m must be > 0, got {args.radio_range_m:g}")
     seeds = args.seeds or ([1] if args.quick else [1, 2, 3, 4, 5])
     artifacts = QUICK_ARTIFACTS if args.quick else ARTIFACTS
+    radio = radio_doc(args.radio_range_m, args.radio_clear)
     worlds = {name: {**WORLDS[name], **({"total_length_m": QUICK_LENGTH_M[name]} if args.quick else {})}
               for name in args.worlds}
     print("$ " + " ".join(shlex.quote(a) for a in [Path(sys.executable).name, *sys.argv]))
@@ -214,17 +249,19 @@ def main(argv: list[str] | None = None) -> int:
         params = ", ".join(f"{k}={v}" for k, v in spec.items() if k != "generator")
         print(f"world {name}: {spec['generator']}({params})")
     print(f"robots: aerial (RMF-Obelix-like), endurance {ENDURANCE_S:.0f} s, mission limit {args.duration_s:.0f} s, "
-          f"radio range {RADIO_RANGE_M:.0f} m, {artifacts} artifacts; seeds {seeds}; "
+          f"radio range {args.radio_range_m:.0f} m{' (clear)' if args.radio_clear else ''}, {artifacts} artifacts; "
+          f"seeds {seeds}; "
           f"{args.scheduler or f'{args.jobs} worker(s)'}; "
           f"load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
     print()
     t0 = time.perf_counter()
     if args.out:
-        runs = run_sweep(worlds, args.methods, seeds, args.duration_s, artifacts, args.out, args.jobs, args.scheduler)
+        runs = run_sweep(worlds, args.methods, seeds, args.duration_s, artifacts, args.out, args.jobs, args.scheduler,
+                         radio)
     else:
         with tempfile.TemporaryDirectory(prefix="team_exploration_") as tmp:
             runs = run_sweep(worlds, args.methods, seeds, args.duration_s, artifacts, Path(tmp), args.jobs,
-                             args.scheduler)
+                             args.scheduler, radio)
     print_tables(runs, list(worlds), args.methods)
     print(f"\n{len(runs)} runs in {time.perf_counter() - t0:.0f} s wall")
     return 0 if runs else 1

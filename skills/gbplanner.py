@@ -367,6 +367,10 @@ class Explore(Skill):
     def terminate(self, new_status: Status) -> None:
         if new_status == Status.INVALID and self.following and self.ctx.robot is not None:
             self.stop_own_motion()
+            # Halted on the way to a frontier (a COHORT robot's T_C ends, a safety block
+            # takes over): the frontier is still unexplored; without this the global
+            # planner, which dropped it when it planned the path, would never go there.
+            self._restore_frontier()
         self.following = False
 
     def _plan(self) -> Status:

@@ -60,7 +60,8 @@ class CohortHub:
     ``frontiers`` (:class:`GlobalFrontiers`); ``graph`` (:class:`GlobalGraph`, G_C);
     ``clusters`` (the current :class:`FrontierCluster` list, largest first) and
     ``links`` (their G_C vertices); ``submaps`` ((robot, index) -> :class:`SubmapInfo`);
-    ``robot_positions`` (last known, from submaps and requests); ``home``;
+    ``robot_positions`` (last known, from submaps and requests) and ``last_heard_s``
+    (when they were true); ``home``;
     ``assignments`` (every :class:`AssignmentRecord`, oldest first) and
     ``last_assignment`` (robot -> its latest); ``stale`` (a submap arrived since the
     frontiers were last computed).
@@ -75,6 +76,7 @@ class CohortHub:
         self.links: list[np.ndarray] = []
         self.submaps: dict[tuple[str, int], SubmapInfo] = {}
         self.robot_positions: dict[str, np.ndarray] = {}
+        self.last_heard_s: dict[str, float] = {}
         self.home = None if home is None else np.asarray(home, float)
         self.assignments: list[AssignmentRecord] = []
         self.last_assignment: dict[str, AssignmentRecord] = {}
@@ -113,6 +115,7 @@ class CohortHub:
         self.submaps[key] = info
         if len(trajectory):
             self.robot_positions[robot] = trajectory[-1].copy()
+            self.last_heard_s[robot] = max(self.last_heard_s.get(robot, -np.inf), float(t_s))
             if self.home is None:
                 self.home = trajectory[0].copy()
         self.stale = True
@@ -130,29 +133,46 @@ class CohortHub:
     def reposition(self, fine: Grid, robot: str, position: np.ndarray, t_s: float,
                    request_id: int = 0) -> Reposition:
         """Answer ``robot``'s call from ``position``: :func:`choose_frontier` with every
-        robot's last known position and home as Dijkstra sources, leaving out the
-        clusters that share points with another robot's latest assignment while it
-        holds (T_C + T_C^e after it was given: a robot that has not called again by
-        then has gone home or lost its way back). Recomputes the frontiers first when
-        a submap arrived since. The answer is recorded."""
+        robot's last known position and home as Dijkstra sources, the clusters that
+        share points with another robot's latest assignment while it holds (T_C + T_C^e
+        after it was given: a robot that has not called again by then has gone home or
+        lost its way back) as held by it, and the other robots holding none that the
+        hub heard from (a submap made or a call) in that time as free.
+        Recomputes the frontiers first when a submap arrived since. The answer is
+        recorded."""
         if self.stale:
             self.update_frontiers()
         self.robot_positions[robot] = np.asarray(position, float).copy()
+        self.last_heard_s[robot] = float(t_s)
         radius = self.params.edge_radius_m
         sources = dict(sorted(self.robot_positions.items()))
         if self.home is not None:
             sources[HOME] = self.home
         entries = {name: self.graph.attach(p, fine, self.common, radius) for name, p in sources.items()}
-        live = [rec.points for other, rec in self.last_assignment.items()
-                if other != robot and t_s - rec.t_s <= self.params.period_s + self.params.extra_explore_s]
-        taken = {i for i, c in enumerate(self.clusters)
-                 if any(len(np.intersect1d(c.voxels, pts, assume_unique=True)) for pts in live)}
+        holders = self.holders(robot, t_s)
+        busy = set().union(*holders.values()) if holders else set()
+        hold = self.params.period_s + self.params.extra_explore_s
+        free = [n for n, heard in sorted(self.last_heard_s.items())
+                if n not in (robot, HOME) and n not in busy and t_s - heard <= hold]
         lo, hi = self.common.bounds
         result = choose_frontier(self.graph, self.clusters, self.links, entries, robot,
                                  best_share_pct=self.params.best_share_pct, box_m=self.params.box_m,
-                                 world_min=lo, world_max=hi, taken=taken)
+                                 world_min=lo, world_max=hi, holders=holders, free=free)
         points = self.clusters[result.cluster].voxels if result.ok else np.zeros(0, dtype=np.int64)
         record = AssignmentRecord(robot, float(t_s), int(request_id), result, points)
         self.assignments.append(record)
         self.last_assignment[robot] = record
         return result
+
+    def holders(self, robot: str, t_s: float) -> dict[int, set[str]]:
+        """Per current cluster (index), the robots other than ``robot`` whose latest
+        assignment, given at most T_C + T_C^e before ``t_s``, shares points with it."""
+        hold = self.params.period_s + self.params.extra_explore_s
+        live = {other: rec.points for other, rec in sorted(self.last_assignment.items())
+                if other != robot and t_s - rec.t_s <= hold and len(rec.points)}
+        out: dict[int, set[str]] = {}
+        for i, c in enumerate(self.clusters):
+            names = {o for o, pts in live.items() if len(np.intersect1d(c.voxels, pts, assume_unique=True))}
+            if names:
+                out[i] = names
+        return out

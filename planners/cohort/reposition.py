@@ -12,20 +12,32 @@ Choices where the paper is silent:
   source is the least, over those vertices, of the path length to the vertex plus the
   straight line from it to the cluster's centroid. Clusters the calling robot cannot
   reach on G_C are left out before the best n_C % are taken.
-* A cluster another robot was sent to (``taken``: the hub passes the clusters of the
-  other robots' latest assignments that still hold) is left out while others remain,
-  so two robots asking from the same place are not sent to one frontier. The
-  distances from every robot and home to the chosen cluster come with the answer
-  (``distances_m``) and are logged.
+* What the distances from every robot are for (the paper computes them, then names
+  only the caller's): a cluster another robot was sent to (``holders``: the hub passes,
+  per cluster, the other robots whose latest assignment still holds it) is left out,
+  so two robots asking from the same place are not sent to one frontier. The unheld
+  clusters are shared between the caller and the other robots that hold none
+  (``free``), as a minimum-distance assignment (scipy ``linear_sum_assignment``) of
+  those robots to the best n_C % of them by size (at least one each while there are
+  enough clusters); the caller gets the cluster the assignment gives it, which is the
+  closest of the best n_C % when no other robot is free. A caller the assignment
+  leaves without one, because free robots nearer to every cluster take them all, gets
+  a held cluster only where it is nearer than every robot holding it; else no
+  frontier (reason ``taken``): it explores on with its own GBPlanner2 rather than
+  fly across the world to a frontier a teammate reaches first. The distances from
+  every robot and home to the chosen cluster come with the answer (``distances_m``)
+  and are logged.
 * The box is centred on the centroid and clipped to the world (a box of 360 m in a
   smaller world is the world).
 """
 from __future__ import annotations
 
 import math
+from collections.abc import Collection, Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.optimize import linear_sum_assignment
 from scipy.sparse.csgraph import dijkstra
 
 from ..frontier import FrontierCluster
@@ -38,7 +50,7 @@ class Reposition:
     none), its centroid ``frontier``, the ``path`` along G_C (from the calling robot's
     entry vertex to the cluster's linked vertex), the box, the cluster's size, the
     path ``distance_m`` and ``reason`` ("ok", "no_frontier", "no_graph",
-    "unreachable"). ``distances_m``: from each source (robot names, "home") to the
+    "unreachable", "taken"). ``distances_m``: from each source (robot names, "home") to the
     chosen cluster."""
 
     cluster: int | None
@@ -96,16 +108,49 @@ def graph_path(pred: np.ndarray, positions: np.ndarray, target: int) -> np.ndarr
     return positions[nodes[::-1]]
 
 
+def assign_unheld(cost: np.ndarray, rival_costs: list[np.ndarray], unheld: np.ndarray, sizes: np.ndarray,
+                  share_pct: float) -> int | None:
+    """The unheld cluster the caller gets when the best ``share_pct`` % of ``unheld`` by
+    size (at least one per robot while there are enough) are shared among it and its
+    free rivals at the least total distance (``cost``: the caller's per cluster;
+    ``rival_costs``: each free rival's). None when the caller gets none."""
+    if len(unheld) == 0:
+        return None
+    top = best_share(sizes, unheld, share_pct)
+    if len(top) <= len(rival_costs):
+        top = best_share(sizes, unheld, 100.0)[: len(rival_costs) + 1]
+    table = np.array([cost[top], *(c[top] for c in rival_costs)])
+    finite = np.isfinite(table)
+    big = 1.0 + 2.0 * (np.abs(table[finite]).sum() if finite.any() else 0.0)
+    rows, cols = linear_sum_assignment(np.where(finite, table, big))
+    mine = cols[rows == 0]
+    if len(mine) == 0 or not np.isfinite(table[0, mine[0]]):
+        return None
+    return int(top[mine[0]])
+
+
+def held_by_farther(cost: np.ndarray, reachable: np.ndarray, holder_costs: Mapping[int, list[np.ndarray]]
+                    ) -> np.ndarray:
+    """The held clusters of ``reachable`` the caller is nearer to than every robot
+    holding them (``holder_costs``: per held cluster, each holder's cost per cluster;
+    an empty array stands for a holder the hub cannot place, which keeps its cluster)."""
+    return np.array([i for i in reachable if int(i) in holder_costs
+                     and all(len(c) and cost[i] < c[i] for c in holder_costs[int(i)])], dtype=np.int64)
+
+
 def choose_frontier(graph: GlobalGraph, clusters: list[FrontierCluster], links: list[np.ndarray],
                     entries: dict[str, int | None], robot: str, *, best_share_pct: float,
                     box_m: tuple[float, float, float], world_min: np.ndarray, world_max: np.ndarray,
-                    taken: frozenset[int] | set[int] = frozenset()) -> Reposition:
-    """Re-position ``robot``: the closest of the best ``best_share_pct`` % clusters.
+                    holders: Mapping[int, Collection[str]] | None = None,
+                    free: Collection[str] = ()) -> Reposition:
+    """Re-position ``robot``: the unheld cluster it gets in the assignment of
+    :func:`assign_unheld`, else the closest of the best ``best_share_pct`` % of the held
+    clusters it is nearer to than their holders (:func:`held_by_farther`), else none.
 
     ``entries``: the G_C vertex of every source (robot names and "home"; None when it
     has none), ``robot`` among them; ``links``: each cluster's linked vertices
-    (:meth:`GlobalGraph.link_frontiers`); ``taken``: clusters other robots were sent
-    to (left out while others remain).
+    (:meth:`GlobalGraph.link_frontiers`); ``holders``: per cluster, the other robots
+    whose latest assignment still holds it; ``free``: the other robots holding none.
     """
     if not clusters:
         return Reposition(None, reason="no_frontier")
@@ -118,15 +163,23 @@ def choose_frontier(graph: GlobalGraph, clusters: list[FrontierCluster], links: 
     reachable = np.flatnonzero(np.isfinite(cost))
     if len(reachable) == 0:
         return Reposition(None, reason="unreachable")
-    free = reachable[~np.isin(reachable, list(taken))]
-    candidates = free if len(free) else reachable
+    costs = {n: cluster_distances(graph, clusters, links, dist[i])[0] for i, n in enumerate(names)}
+    none = np.zeros(0)
+    holder_costs = {int(i): [costs.get(h, none) for h in sorted(hs)]
+                    for i, hs in (holders or {}).items() if hs}
+    rivals = [costs[n] for n in sorted(free) if n in costs and n != robot]
     sizes = np.array([c.size for c in clusters])
-    top = best_share(sizes, candidates, best_share_pct)
-    chosen = int(top[np.argmin(cost[top])])
+    unheld = reachable[[int(i) not in holder_costs for i in reachable]]
+    chosen = assign_unheld(cost, rivals, unheld, sizes, best_share_pct)
+    if chosen is None:
+        mine = held_by_farther(cost, reachable, holder_costs)
+        if len(mine) == 0:
+            return Reposition(None, reason="taken")
+        top = best_share(sizes, mine, best_share_pct)
+        chosen = int(top[np.argmin(cost[top])])
     cluster = clusters[chosen]
     box_min, box_max = exploration_box(cluster.centroid, box_m, world_min, world_max)
-    others = {n: float(cluster_distances(graph, [cluster], [links[chosen]], dist[i])[0][0])
-              for i, n in enumerate(names)}
+    others = {n: float(costs[n][chosen]) for n in names}
     return Reposition(chosen, frontier=cluster.centroid.copy(), path=graph_path(pred[0], graph.positions,
                       int(via[chosen])), box_min=box_min, box_max=box_max, cluster_size=cluster.size,
                       distance_m=float(cost[chosen]), distances_m=others)

@@ -116,10 +116,11 @@ class UpdateGlobalFrontiers(Skill):
 
 
 class AnswerRepositionRequests(HubSkill):
-    """Answer every ``cohort_request``: send the caller a ``cohort_assignment`` with the
-    closest of the best n_C % frontier clusters, the path to it along G_C and the box
-    D around it, or ``frontier`` None and a ``reason`` ("no_frontier", "no_graph",
-    "unreachable") when there is none. The frontiers are recomputed first if a submap
+    """Answer every ``cohort_request``: send the caller a ``cohort_assignment`` with its
+    frontier cluster among the best n_C % (the closest when no other robot competes:
+    :func:`~delve.planners.cohort.choose_frontier`), the path to it along G_C and the
+    box D around it, or ``frontier`` None and a ``reason`` ("no_frontier", "no_graph",
+    "unreachable", "taken") when there is none. The frontiers are recomputed first if a submap
     arrived since.
 
     Reads services ``radio``, ``map``, ``cohort_hub``. Logs ``cohort_assignment`` per

@@ -13,7 +13,7 @@ from py_trees.ports import PortInformation
 from ...planners.geometry import xyz
 from ..base import Param, Skill
 from ..motion import GoTo
-from .robot import cohort_params, linked
+from .robot import cohort_params, linked, record_transit
 
 #: What ``CohortTimer`` waits for: T_C or T_C^e (fields of CohortParams).
 SPANS = ("period_s", "extra_explore_s")
@@ -76,14 +76,17 @@ class ReturnToLinkPoint(GoTo):
     the first), ping the hub there, and when it does not answer (or the point cannot be
     reached) go on to the point before, and so on.
 
-    Reads ``cohort_link_points``; writes ``goto_failure`` as ``GoTo``. Logs
+    The way flown is added to GBPlanner2's global graph as ``FollowHubPath`` adds
+    its own. Reads ``cohort_link_points``; writes ``goto_failure`` as ``GoTo``. Logs
     ``cohort_backtrack`` when it sets out and ``cohort_link_point`` at each point
     reached (linked or not). Returns RUNNING on the way; SUCCESS at a point where the
     hub answers; FAILURE when no point offers a link.
     """
 
     PARAMS = {**{k: v for k, v in GoTo.PARAMS.items() if k not in ("goal", "goal_key")},
-              "ping_attempts": Param(int, 3, "pings tried at a point before it counts as without link", minimum=1)}
+              "ping_attempts": Param(int, 3, "pings tried at a point before it counts as without link", minimum=1),
+              "graph_spacing_m": Param(float, 2.0, "the way flown joins GBPlanner2's global graph a vertex this "
+                                       "far apart", exclusive_minimum=0)}
     INPUT_PORTS = {"cohort_link_points": PortInformation(list, required=False, default_value=[],
                                                          description="[x, y, z] points that offered a link to the "
                                                          "hub, oldest first")}
@@ -102,6 +105,11 @@ class ReturnToLinkPoint(GoTo):
 
     def _read_goal(self) -> np.ndarray | None:
         return self.goal
+
+    def update(self) -> Status:
+        status = super().update()
+        record_transit(self.ctx, self.robot.position, self.p["graph_spacing_m"])
+        return status
 
     def arrived(self) -> Status:
         ok = linked(self.robot.radio, self.p["ping_attempts"])

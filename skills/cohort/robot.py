@@ -17,6 +17,7 @@ from py_trees.ports import PortInformation
 from ...planners.cohort import CohortParams
 from ...planners.geometry import xyz
 from ..base import AgentContext, Param, Skill, mailbox
+from ..gbplanner import SERVICE as GBPLANNER_SERVICE
 from ..motion import GoTo
 from .hub import ASSIGNMENT, PARAMS_SERVICE, REQUEST, SUBMAP
 
@@ -29,6 +30,22 @@ REQUEST_COUNT = "cohort_requests"
 def cohort_params(ctx: AgentContext) -> CohortParams:
     """The team's COHORT parameters (the paper's when no strategy gave them)."""
     return ctx.services.get(PARAMS_SERVICE) or CohortParams()
+
+
+def record_transit(ctx: AgentContext, position: np.ndarray, spacing_m: float) -> None:
+    """Add ``position`` to the agent's GBPlanner2 global graph as a visited vertex joined
+    to the last one, when it lies ``spacing_m`` or more from it (nothing when the agent
+    has no GBPlanner2). A COHORT transit (the hub's path, the way back to a link point)
+    runs outside the explorer, and the global graph only records where the explorer
+    planned: without these vertices the next plan would join the end of the transit to
+    its start by one straight edge, through rock, which is cut when checked and leaves
+    the frontiers and home on the far side unreachable in the robot's own graph."""
+    svc = ctx.services.get(GBPLANNER_SERVICE)
+    if svc is None:
+        return
+    gp = svc.planner.global_planner
+    if np.linalg.norm(np.asarray(position, float) - gp.position_of(gp.robot_vertex)) >= spacing_m:
+        gp.record_position(np.asarray(position, float))
 
 
 def linked(radio: Any, attempts: int, other: str = HUB) -> bool:
@@ -219,14 +236,17 @@ class FollowHubPath(GoTo):
     a blocked path or an arrival short of the goal is re-planned as ``GoTo`` plans
     (navigation graph of the onboard map, or GBPlanner2's global graph).
 
-    Reads ``cohort_goal`` and ``cohort_path``; writes ``goto_failure`` as ``GoTo``.
-    Returns SUCCESS at once when the hub gave no goal (nothing to follow) and within
+    The way flown is added to GBPlanner2's global graph every ``graph_spacing_m``
+    (:func:`record_transit`). Reads ``cohort_goal`` and ``cohort_path``; writes
+    ``goto_failure`` as ``GoTo``. Returns SUCCESS at once when the hub gave no goal (nothing to follow) and within
     ``tolerance_m`` of the goal; RUNNING on the way; FAILURE as ``GoTo``.
     """
 
     PARAMS = {**{k: v for k, v in GoTo.PARAMS.items() if k != "goal"},
               "goal_key": Param(str, "cohort_goal", "blackboard key holding the goal [x, y, z]", key=True),
-              "tolerance_m": Param(float, 2.0, "distance to the goal that counts as arrived", exclusive_minimum=0)}
+              "tolerance_m": Param(float, 2.0, "distance to the goal that counts as arrived", exclusive_minimum=0),
+              "graph_spacing_m": Param(float, 2.0, "the way flown joins GBPlanner2's global graph a vertex this "
+                                       "far apart", exclusive_minimum=0)}
     INPUT_PORTS = {**GoTo.INPUT_PORTS,
                    "cohort_path": PortInformation(list, required=False, description="[[x, y, z], ...] the hub's path")}
 
@@ -237,7 +257,9 @@ class FollowHubPath(GoTo):
         if self.goal is None and self.read("goal") is None:
             self.feedback_message = "no frontier assigned"
             return Status.SUCCESS
-        return super().update()
+        status = super().update()
+        record_transit(self.ctx, self.robot.position, self.p["graph_spacing_m"])
+        return status
 
     def _path(self, grid: Any) -> tuple[np.ndarray | None, str, str, str]:
         hub_path = self.read("cohort_path")
@@ -246,4 +268,5 @@ class FollowHubPath(GoTo):
         return super()._path(grid)
 
 
-__all__ = ["HUB", "REQUEST_COUNT", "CallHub", "FollowHubPath", "SendSubmaps", "cohort_params", "linked"]
+__all__ = ["HUB", "REQUEST_COUNT", "CallHub", "FollowHubPath", "SendSubmaps", "cohort_params", "linked",
+           "record_transit"]

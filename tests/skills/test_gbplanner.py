@@ -9,6 +9,7 @@ import py_trees
 import pytest
 from delve.executive.errors import DelveError
 from delve.executive.tree_loader import build_tree, check_context
+from delve.planners.gbplanner2 import Frontier
 from delve.planners.gbplanner2 import synthetic as syn
 from delve.planners.gbplanner2.local_map import LocalMap
 from delve.planners.gbplanner2.local_planner import ShrinkingLocalPlanner
@@ -271,6 +272,26 @@ def test_a_blocked_path_is_rerouted_on_the_navigation_graph_once(half_mapped):
     robot.block_at = None
     node.tick_once()
     assert len(events(ctx, "explore_path_blocked")) == 1 and len(events(ctx, "explore_rerouted")) == 1
+
+
+@pytest.mark.parametrize("halted", [True, False])
+def test_a_frontier_halted_on_the_way_to_goes_back_to_the_global_planner(half_mapped, halted):
+    """The global planner drops a frontier when it plans the way there (its vertex turns
+    "visited"); Explore halted on that way (a COHORT robot's T_C ends) gives it back,
+    as after a blocked path. Explore that ends by itself keeps it dropped."""
+    grid, a, _ = half_mapped
+    robot = FakeRobot(grid, body(a, 3.0))
+    ctx = make_ctx(robot)
+    node = explore(ctx)
+    node.tick_once()  # plans and follows a path
+    assert node.status == Status.RUNNING and node.following
+    gp = gbplanner(ctx, robot, node.overrides).planner.global_planner
+    far = body(a, 22.0)
+    gp.graph.add_node(10**6, pos=far, kind="visited")  # as plan_reposition leaves its target
+    node.frontier = Frontier(10**6, far, 100.0, 0)
+    node.stop(Status.INVALID if halted else Status.SUCCESS)
+    assert (10**6 in gp.frontiers) == halted
+    assert gp.graph.nodes[10**6]["kind"] == ("frontier" if halted else "visited")
 
 
 def test_explore_stays_inside_the_exploration_box(half_mapped):

@@ -69,3 +69,26 @@ def test_the_same_submaps_give_the_same_answers():
         r = hub.reposition(fine, "a", np.array([25, 20, Z]), 10.0)
         answers.append((r.frontier.tolist(), r.path.tolist(), hub.graph.positions.tolist()))
     assert answers[0] == answers[1]
+
+
+def test_clusters_held_by_others_and_free_robots_heard_from_lately_reach_the_choice(monkeypatch):
+    """The hub passes choose_frontier, per cluster, the other robots whose latest
+    assignment holds it, and as free the others it heard from within T_C + T_C^e."""
+    import delve.planners.cohort.hub as hub_module
+
+    hub, fine = hub_after(TRUNK, JUNCTION)   # "a" and "b" heard from at t = 0
+    at = np.array([30, 20, Z])
+    ra = hub.reposition(fine, "a", at, 10.0)
+    seen = {}
+    real = hub_module.choose_frontier
+
+    def spy(*args, **kw):
+        seen.update(kw)
+        return real(*args, **kw)
+
+    monkeypatch.setattr(hub_module, "choose_frontier", spy)
+    hub.reposition(fine, "c", at, 20.0)
+    assert seen["holders"] == {ra.cluster: {"a"}} and seen["free"] == ["b"]
+    hold = PARAMS.period_s + PARAMS.extra_explore_s
+    hub.reposition(fine, "c", at, hold + 1.0)   # "b" silent since t = 0; "a" still holds
+    assert seen["holders"] == {ra.cluster: {"a"}} and seen["free"] == []

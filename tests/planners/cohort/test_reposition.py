@@ -28,8 +28,10 @@ CLUSTERS = [cluster(100, 10), cluster(90, 5), cluster(80, 3), cluster(10, 1)]
 LINKS = [np.array([10]), np.array([5]), np.array([3]), np.array([1])]
 
 
-def choose(share: float = 50.0, clusters=CLUSTERS, links=LINKS, **kw):
-    return choose_frontier(line_graph(), clusters, links, {"r": 0, "home": 10}, "r", best_share_pct=share,
+def choose(share: float = 50.0, clusters=CLUSTERS, links=LINKS, other: int | None = None, **kw):
+    """Choose for robot "r" at vertex 0 (home at vertex 10; robot "o" at vertex ``other``)."""
+    entries = {"r": 0, "home": 10, **({} if other is None else {"o": other})}
+    return choose_frontier(line_graph(), clusters, links, entries, "r", best_share_pct=share,
                            box_m=BOX, world_min=WORLD[0], world_max=WORLD[1], **kw)
 
 
@@ -55,9 +57,36 @@ def test_the_box_is_clipped_to_the_world():
     assert np.allclose(lo, 0) and np.allclose(hi, [30, 20, 5])
 
 
-def test_a_cluster_another_robot_was_sent_to_is_left_out_while_others_remain():
-    assert choose(50.0, taken={1}).cluster == 2
-    assert choose(50.0, taken={0, 1, 2, 3}).cluster == 1
+def test_a_cluster_another_robot_holds_is_left_out_while_others_remain():
+    assert choose(50.0, other=9, holders={1: {"o"}}).cluster == 2
+    assert choose(50.0, other=9).cluster == 1
+
+
+@pytest.mark.parametrize("other, chosen", [(9, 2), (2, None)])
+def test_when_every_cluster_is_held_the_caller_gets_one_only_where_it_is_nearer_than_its_holder(other, chosen):
+    """"o" at vertex 9 is nearer to the clusters at x = 10 and 5; at vertex 2, to all
+    (a tie at x = 1 leaves the cluster to its holder)."""
+    r = choose(50.0, other=other, holders={i: {"o"} for i in range(4)})
+    assert r.cluster == chosen
+    assert r.ok or (r.reason == "taken" and r.frontier is None and r.box_min is None)
+
+
+def test_a_holder_the_hub_cannot_place_keeps_its_cluster():
+    assert choose(100.0, holders={i: {"ghost"} for i in range(4)}).reason == "taken"
+
+
+@pytest.mark.parametrize("other, free, chosen", [(9, {"o"}, 1), (9, set(), 0), (None, {"o"}, 0)])
+def test_unheld_clusters_are_shared_with_the_free_robots_at_the_least_total_distance(other, free, chosen):
+    """Alone, "r" gets the largest (x = 10, 11 m away). "o" free at x = 9 is 2 m from it:
+    the two largest are shared, "o" takes x = 10 and "r" x = 5 (8 m in all against 16);
+    "o" busy, or unplaced, changes nothing."""
+    assert choose(25.0, other=other, free=free).cluster == chosen
+
+
+@pytest.mark.parametrize("other, chosen", [(9, None), (None, 0)])
+def test_a_caller_the_free_robots_leave_without_a_cluster_gets_none(other, chosen):
+    r = choose(50.0, clusters=CLUSTERS[:1], links=LINKS[:1], other=other, free={"o"})
+    assert r.cluster == chosen and r.reason == ("taken" if chosen is None else "ok")
 
 
 def test_clusters_the_robot_cannot_reach_are_left_out():

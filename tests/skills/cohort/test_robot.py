@@ -2,6 +2,7 @@
 hub, re-positioning, the lost-link rule) on the fake robot, with a scripted hub."""
 from __future__ import annotations
 
+import networkx as nx
 import numpy as np
 import py_trees
 import pytest
@@ -11,6 +12,7 @@ from delve.planners.occupancy import FREE, UNKNOWN
 from delve.skills.cohort.lost_link import CohortTimer, ExplorationOver, ReturnToLinkPoint
 from delve.skills.cohort.hub import ASSIGNMENT, REQUEST, SUBMAP
 from delve.skills.cohort.robot import CallHub, FollowHubPath, SendSubmaps
+from delve.skills.gbplanner import SERVICE as GBPLANNER, gbplanner
 from py_trees.common import Status
 
 from ..fakes import FakeRobot, bb, body, events, make_ctx, run
@@ -181,6 +183,29 @@ def test_follow_hub_path_drives_the_hubs_path_first(tunnel, robot):
     assert run(node, ctx, robot) == Status.SUCCESS
     assert np.allclose(robot.paths[0][: len(hub_path)], hub_path)
     assert events(ctx, "goto")[0]["source"] == "cohort"
+
+
+@pytest.mark.parametrize("planner", [True, False])
+def test_the_way_flown_joins_gbplanner2s_global_graph(tunnel, robot, planner):
+    """From home to 20 m along the hub's path, a chain of visited vertices every
+    graph_spacing_m joins GBPlanner2's graph (none is made for an agent without one)."""
+    _, a, _ = tunnel
+    ctx = ctx_for(robot)
+    if planner:
+        gbplanner(ctx, robot)
+    hub_path = [body(a, 10.0).tolist(), body(a, 20.0).tolist()]
+    py_trees.blackboard.Blackboard.set("/r1/cohort_path", hub_path)
+    py_trees.blackboard.Blackboard.set("/r1/cohort_goal", hub_path[-1])
+    assert run(FollowHubPath(name="Go", ctx=ctx, graph_spacing_m=2.5), ctx, robot) == Status.SUCCESS
+    if not planner:
+        assert GBPLANNER not in ctx.services
+        return
+    gp = ctx.services[GBPLANNER].planner.global_planner
+    end = gp.robot_vertex
+    assert np.linalg.norm(gp.position_of(end) - robot.position) < 2.5
+    hops = nx.shortest_path(gp.graph, gp.home_vertex, end)
+    steps = np.linalg.norm(np.diff([gp.position_of(v) for v in hops], axis=0), axis=1)
+    assert len(hops) >= 6 and steps.max() < 2.5 + 1.0
 
 
 def test_follow_hub_path_without_a_goal_succeeds_at_once(robot):
