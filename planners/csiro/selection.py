@@ -139,6 +139,43 @@ def uav_frontier_complete(frontier: Frontier, agent_position: np.ndarray, params
     return bool(np.linalg.norm(np.asarray(frontier.mean, float) - agent_position) <= params.uav_blacklist_m)
 
 
+class UavBlacklist:
+    """The frontiers a UAV completed or gave up on (Section IV-B), each as it was then.
+
+    The UAV blacklists a frontier it made no progress towards in 15 s by "the same criterion" as
+    the ground robot's failure penalty (Algorithm 3), which is cleared when the frontier is
+    updated; a frontier it reached within eta_blacklist of its centre is complete. Algorithm 2
+    keeps a frontier's id while it changes (the opening of a side passage the UAV flew past, the
+    head of a tunnel), so an entry holds while the frontier of that id is the version blacklisted:
+    updated, it is a new frontier to select (or to skip while the UAV is within eta_blacklist of
+    its centre)."""
+
+    def __init__(self) -> None:
+        self._versions: dict[int, Frontier] = {}
+
+    def add(self, frontier: Frontier) -> None:
+        """Blacklist ``frontier`` as it is now."""
+        self._versions[int(frontier.id)] = frontier
+
+    def holds(self, frontier: Frontier) -> bool:
+        """Whether ``frontier`` is blacklisted: the version of its id that was blacklisted."""
+        return self._versions.get(int(frontier.id)) is frontier
+
+    def ids(self, frontiers: Sequence[Frontier]) -> list[int]:
+        """The ids of ``frontiers`` blacklisted, sorted."""
+        return sorted(int(f.id) for f in frontiers if self.holds(f))
+
+    def __contains__(self, frontier_id: object) -> bool:
+        """Whether an entry of ``frontier_id`` exists (whether or not that version is current)."""
+        return frontier_id in self._versions
+
+    def __len__(self) -> int:
+        return len(self._versions)
+
+    def clear(self) -> None:
+        self._versions.clear()
+
+
 def uav_rewards(frontiers: Sequence[Frontier], agent_position: np.ndarray, momentum: UavMomentum | None,
                 params: CsiroSelectionParams) -> np.ndarray:
     """(F,) equation 16: p_f * size_f^2 / max{eta_blacklist, d_w(o_f, a)} with o_f the frontier's
@@ -159,28 +196,38 @@ def uav_rewards(frontiers: Sequence[Frontier], agent_position: np.ndarray, momen
     return out
 
 
+def rank_uav_frontiers(frontiers: Sequence[Frontier], agent_position: np.ndarray, momentum: UavMomentum | None,
+                       params: CsiroSelectionParams, *, blacklist: Collection[int] = ()
+                       ) -> list[tuple[Frontier, UavMomentum]]:
+    """Every frontier of at least ``uav_min_area_m2``, not in ``blacklist`` and not already
+    complete, by decreasing equation-16 reward (equal rewards: the smaller id first), each with
+    the momentum to pass next time if it is selected (the direction kept while the same frontier
+    stays selected)."""
+    agent = np.asarray(agent_position, float)
+    banned = set(blacklist)
+    ok = [f for f in frontiers if f.area >= params.uav_min_area_m2 and f.id not in banned
+          and not uav_frontier_complete(f, agent, params)]
+    rewards = uav_rewards(ok, agent, momentum, params)
+    ranked = [ok[j] for j in sorted(range(len(ok)), key=lambda j: (-rewards[j], ok[j].id))]
+    return [(f, _momentum_for(f, agent, momentum)) for f in ranked]
+
+
+def _momentum_for(frontier: Frontier, agent: np.ndarray, momentum: UavMomentum | None) -> UavMomentum:
+    if momentum is not None and momentum.frontier_id == frontier.id:
+        return momentum
+    v = np.asarray(frontier.mean, float) - agent
+    return UavMomentum(frontier_id=frontier.id, direction=v / np.linalg.norm(v))
+
+
 def select_uav_frontier(frontiers: Sequence[Frontier], agent_position: np.ndarray, momentum: UavMomentum | None,
                         params: CsiroSelectionParams, *, blacklist: Collection[int] = ()
                         ) -> tuple[Frontier, UavMomentum] | None:
-    """The frontier of highest equation-16 reward among those of at least ``uav_min_area_m2``,
-    not in ``blacklist`` and not already complete, with the momentum to pass next time (the
-    direction kept while the same frontier stays selected); equal rewards go to the smaller
-    id. None when there is none."""
-    agent = np.asarray(agent_position, float)
-    banned = set(blacklist)
-    ok = [i for i, f in enumerate(frontiers) if f.area >= params.uav_min_area_m2 and f.id not in banned
-          and not uav_frontier_complete(f, agent, params)]
-    if not ok:
-        return None
-    rewards = uav_rewards([frontiers[i] for i in ok], agent, momentum, params)
-    best_at = min(range(len(ok)), key=lambda j: (-rewards[j], frontiers[ok[j]].id))
-    best = frontiers[ok[best_at]]
-    if momentum is not None and momentum.frontier_id == best.id:
-        return best, momentum
-    v = np.asarray(best.mean, float) - agent
-    return best, UavMomentum(frontier_id=best.id, direction=v / np.linalg.norm(v))
+    """The first of :func:`rank_uav_frontiers`: the frontier of highest equation-16 reward with
+    its momentum; None when there is none."""
+    ranked = rank_uav_frontiers(frontiers, agent_position, momentum, params, blacklist=blacklist)
+    return ranked[0] if ranked else None
 
 
-__all__ = ["EIGEN_SCALE", "EIGEN_SPAN", "FailedFrontiers", "GoalProgress", "UavMomentum", "UgvChoice",
-           "select_ugv_frontier", "select_uav_frontier", "uav_frontier_complete", "uav_frontier_size_m",
-           "uav_rewards", "ugv_utilities", "weighted_distance"]
+__all__ = ["EIGEN_SCALE", "EIGEN_SPAN", "FailedFrontiers", "GoalProgress", "UavBlacklist", "UavMomentum",
+           "UgvChoice", "rank_uav_frontiers", "select_ugv_frontier", "select_uav_frontier", "uav_frontier_complete",
+           "uav_frontier_size_m", "uav_rewards", "ugv_utilities", "weighted_distance"]

@@ -69,7 +69,7 @@ class FollowFrontierGoal(GoTo):
         self.watch: GoalProgress | None = None
         self.watch_key: tuple[str, int] | None = None
         self.arrived_s: float | None = None
-        self.arrived_version: float | None = None  # the frontier's updated_s on arrival
+        self.arrived_version: Any = None  # on arrival: the summary's updated_s (own Frontier, flying robot)
 
     def initialise(self) -> None:
         super().initialise()
@@ -114,15 +114,18 @@ class FollowFrontierGoal(GoTo):
         if not r.mobility.aerial and self.key[0] != self.ctx.name:
             st.trajectory.visit(r.position)
             return self._done("reached a teammate's frontier")
-        summary = st.summaries.get(self.key)
-        version = None if summary is None else summary.updated_s
+        if r.mobility.aerial:     # its own frontier, replaced by a new object when it changes
+            version: Any = self._own_frontier()
+        else:
+            summary = st.summaries.get(self.key)
+            version = None if summary is None else summary.updated_s
         if self.arrived_s is None:
             if r.mobility.aerial and self._nearer_place(st):
                 status = self.plan()
                 return self._failed(st, self.feedback_message) if status == Status.FAILURE else Status.RUNNING
             self.arrived_s, self.arrived_version = now, version
             st.look_due = True
-        if version != self.arrived_version:
+        if (version is not self.arrived_version) if r.mobility.aerial else (version != self.arrived_version):
             return self._done("changed")
         if now - self.arrived_s >= self.p["dwell_s"]:
             return self._failed(st, f"still a frontier {self.p['dwell_s']:g} s after reaching its observer")
@@ -143,6 +146,12 @@ class FollowFrontierGoal(GoTo):
         self.watch = GoalProgress(self.goal, st.selection)
         return True
 
+    def _own_frontier(self) -> Any:
+        """The robot's own frontier of the goal's key, None when it is gone (or a teammate's)."""
+        if self.key is None or self.key[0] != self.ctx.name:
+            return None
+        return next((f for f in csiro_state(self.ctx).frontiers.frontiers if f.id == self.key[1]), None)
+
     def _done(self, why: str) -> Status:
         self.stop_own_motion()
         self.moving = False
@@ -153,11 +162,11 @@ class FollowFrontierGoal(GoTo):
         """Why the goal is over ('' while it is not)."""
         key, r = self.key, self.robot
         if r.mobility.aerial:
-            frontier = next((f for f in st.frontiers.frontiers if f.id == key[1]), None)
+            frontier = self._own_frontier()
             if frontier is None:
                 return "explored"
             if uav_frontier_complete(frontier, r.position, st.selection):
-                st.blacklist.add(key[1])
+                st.blacklist.add(frontier)
                 return "complete"
             return ""
         summary = st.summaries.get(key)
@@ -172,7 +181,8 @@ class FollowFrontierGoal(GoTo):
         self.moving = False
         key = self.key
         if self.robot.mobility.aerial:
-            st.blacklist.add(key[1])
+            if (frontier := self._own_frontier()) is not None:
+                st.blacklist.add(frontier)
         elif key in st.summaries:
             st.failed.mark(st.summaries[key])
         self.watch = None

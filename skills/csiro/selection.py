@@ -9,13 +9,15 @@ import numpy as np
 from py_trees.common import Status
 from py_trees.ports import PortInformation
 
+from ...planners.csiro.frontier_types import Frontier
 from ...planners.csiro.observer import within_elevations
-from ...planners.csiro.selection import select_uav_frontier, select_ugv_frontier
+from ...planners.csiro.selection import rank_uav_frontiers, select_ugv_frontier, uav_frontier_complete
 from ...planners.csiro.topometric import frontier_node
 from ...planners.geometry import xyz
 from ...planners.occupancy import Grid
 from ...planners.visibility import line_of_sight
 from ..base import Param, Skill
+from ..navigation import navigator
 from .follow import reachable_near
 from .frontiers import body_lift
 from .state import csiro_state
@@ -87,7 +89,10 @@ class SelectUgvFrontier(_Select):
 class SelectUavFrontier(_Select):
     """Equation 16 for a flying robot, over its own frontiers: size, z-weighted distance and
     momentum, none smaller than the size limit, blacklisted or complete. Its goal is the place
-    of the navigation graph it can reach that lies nearest the frontier's centre. A frontier
+    of the navigation graph it can reach that lies nearest the frontier's centre; a frontier whose
+    centre no such place comes within eta_blacklist of (a patch in rock or beyond a wall: the UAV
+    could never complete it) is skipped at this selection (``csiro_frontier_out_of_reach``, once
+    per frontier). A frontier
     that lies wholly in its sensor's blind cones and behind rock of the onboard map seen from
     that place (a patch beyond a roof or floor whose cached points left gaps) is blacklisted at
     once (``csiro_frontier_behind_surface``) and the next one taken.
@@ -99,23 +104,54 @@ class SelectUavFrontier(_Select):
     def update(self) -> Status:
         r, name = self.robot, self.ctx.name
         st = csiro_state(self.ctx, r.view_up_deg)
-        while True:   # each turn blacklists one frontier more
-            picked = select_uav_frontier(st.frontiers.frontiers, r.position, st.momentum, st.selection,
-                                         blacklist=sorted(st.blacklist))
-            if picked is None:
-                return self.none_left()
-            frontier, momentum = picked
-            near = reachable_near(self.ctx, r, frontier.mean)
+        ranked = rank_uav_frontiers(st.frontiers.frontiers, r.position, st.momentum, st.selection,
+                                    blacklist=st.blacklist.ids(st.frontiers.frontiers))
+        for frontier, momentum in ranked:   # by eq. 16; skipped: out of reach, blacklisted: behind rock
+            near, unreachable = self._nearest_place(frontier)
+            if unreachable:
+                # Section IV-B: the UAV flies to the frontier's centre and completes the frontier
+                # within eta_blacklist of it. A centre that no reachable place comes within
+                # eta_blacklist of (in rock, beyond a wall) cannot be completed: skipped for now.
+                if frontier.id not in st.out_of_reach_logged and near is not None:
+                    st.out_of_reach_logged.add(frontier.id)
+                    self.event("csiro_frontier_out_of_reach", id=frontier.id, centre=xyz(frontier.mean, 2),
+                               nearest_m=round(float(np.linalg.norm(near[1] - frontier.mean)), 2))
+                continue
             place = r.position if near is None else near[1]
             fp = st.frontier_params
             if within_elevations(frontier.points - place, (fp.elevation_min_deg, fp.elevation_max_deg)).any() or \
                     in_sight(r.onboard_map, place, frontier.points):
                 break
-            st.blacklist.add(frontier.id)
+            st.blacklist.add(frontier)
             self.event("csiro_frontier_behind_surface", id=frontier.id, centre=xyz(frontier.mean, 2))
+        else:
+            return self.none_left()
         st.momentum = momentum
         return self.chosen((name, frontier.id), frontier.mean if near is None else near[1],
                            area_m2=round(frontier.area, 2))
+
+    def _nearest_place(self, frontier: Frontier) -> tuple[tuple[np.ndarray, np.ndarray] | None, bool]:
+        """The path to the reachable place nearest ``frontier``'s centre and that place (None off
+        the graph), and whether that place is farther than eta_blacklist from the centre (out of
+        reach). A frontier out of reach is looked for again on the navigation graph rebuilt from
+        the current map (the graph may be ``rebuild_period_s`` old) once per version of it (each
+        update of Algorithm 2 replaces the frontier); that version stays out of reach, without a
+        search, until the graph is rebuilt."""
+        st, nav = csiro_state(self.ctx), navigator(self.ctx, self.robot)
+        checked = st.out_of_reach.get(frontier.id)
+        if checked is not None and checked[0] is frontier and checked[1] is nav.graph():
+            return None, True
+        near = reachable_near(self.ctx, self.robot, frontier.mean)
+        if near is not None and uav_frontier_complete(frontier, near[1], st.selection):
+            st.out_of_reach.pop(frontier.id, None)
+            return near, False
+        if checked is None or checked[0] is not frontier:
+            near = reachable_near(self.ctx, self.robot, frontier.mean, fresh=True) or near
+        if near is not None and not uav_frontier_complete(frontier, near[1], st.selection):
+            st.out_of_reach[frontier.id] = (frontier, nav.graph())
+            return near, True
+        st.out_of_reach.pop(frontier.id, None)
+        return near, False
 
 
 def in_sight(voxel_map: Any, eye: np.ndarray, points: np.ndarray) -> bool:

@@ -9,12 +9,13 @@ other robots' current goals, the failed goals and the topometric map.
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
+from typing import Any
 
 import numpy as np
 
 from ...planners.csiro.params import CsiroFrontierParams
 from ...planners.csiro.point_cache import PointCache
-from ...planners.csiro.selection import FailedFrontiers, UavMomentum
+from ...planners.csiro.selection import FailedFrontiers, UavBlacklist, UavMomentum
 from ...planners.csiro.selection_params import CsiroSelectionParams
 from ...planners.csiro.sequential import SequentialFrontiers
 from ...planners.csiro.sharing import FrontierKey, FrontierSummary, TrajectoryPoints
@@ -67,9 +68,14 @@ class CsiroState:
     goal: FrontierKey | None = None
     #: A frontier update is due where the robot stands (it reached its goal to look from there).
     look_due: bool = False
-    #: The UAV's momentum (equation 16) and the frontier ids it blacklisted.
+    #: The UAV's momentum (equation 16) and the frontiers it blacklisted (each version blacklisted).
     momentum: UavMomentum | None = None
-    blacklist: set[int] = field(default_factory=set)
+    blacklist: UavBlacklist = field(default_factory=UavBlacklist)
+    #: Frontier ids logged as out of the UAV's reach (``csiro_frontier_out_of_reach``, once each),
+    #: and per id the version of the frontier found out of reach and the navigation graph it was
+    #: found on (no search again while both are the same).
+    out_of_reach_logged: set[int] = field(default_factory=set)
+    out_of_reach: dict[int, tuple[Any, Any]] = field(default_factory=dict)
     #: Explore-sync: when and where the link to the base station was last seen, and where the
     #: last sync began (the region to return to).
     contact_s: float = 0.0

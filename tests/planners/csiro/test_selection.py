@@ -7,7 +7,9 @@ from delve.planners.csiro.frontier_types import Frontier
 from delve.planners.csiro.selection import (
     FailedFrontiers,
     GoalProgress,
+    UavBlacklist,
     UavMomentum,
+    rank_uav_frontiers,
     select_uav_frontier,
     select_ugv_frontier,
     uav_frontier_size_m,
@@ -148,6 +150,25 @@ def test_uav_skips_small_blacklisted_and_complete_frontiers():
     ok = frontier(4, [30.0, 0.0, 0.0])
     assert select_uav_frontier([small, near, banned, ok], np.zeros(3), None, P, blacklist=[3])[0].id == 4
     assert select_uav_frontier([small, near], np.zeros(3), None, P) is None
+
+
+def test_uav_blacklist_holds_until_the_frontier_is_updated():
+    blacklist = UavBlacklist()
+    done = frontier(7, [10.0, 0.0, 0.0])
+    blacklist.add(done)
+    assert blacklist.holds(done) and blacklist.ids([done, frontier(8, [10.0, 0.0, 0.0])]) == [7]
+    updated = frontier(7, [10.5, 1.0, 0.0])                              # same id, a new version (Algorithm 2)
+    assert not blacklist.holds(updated) and blacklist.ids([updated]) == [] and 7 in blacklist
+    assert select_uav_frontier([updated], np.zeros(3), None, P, blacklist=blacklist.ids([updated]))[0].id == 7
+
+
+def test_uav_ranking_is_by_reward_then_id_and_its_first_is_the_selection():
+    fs = [frontier(5, [30.0, 0.0, 0.0]), frontier(2, [10.0, 0.0, 0.0]), frontier(3, [-10.0, 0.0, 0.0]),
+          frontier(4, [2.0, 0.0, 0.0]), frontier(6, [8.0, 0.0, 0.0], area=1.0), frontier(7, [12.0, 0.0, 0.0])]
+    ranked = rank_uav_frontiers(fs, np.zeros(3), None, P, blacklist=[7])
+    assert [f.id for f, _ in ranked] == [2, 3, 5]           # 4 complete, 6 too small, 7 blacklisted; 2 = 3 by reward
+    assert all(m.frontier_id == f.id for f, m in ranked)
+    assert select_uav_frontier(fs, np.zeros(3), None, P, blacklist=[7])[0] is ranked[0][0]
 
 
 def test_uav_distance_is_at_least_the_blacklist_radius():

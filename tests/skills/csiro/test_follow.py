@@ -9,6 +9,7 @@ import py_trees
 from delve.planners.occupancy import FREE, OCCUPIED, UNKNOWN
 from delve.skills.csiro import FollowFrontierGoal, SelectUavFrontier, SelectUgvFrontier, UpdateFrontiers, \
     csiro_state
+from delve.skills.csiro.follow import reachable_near
 from delve.skills.navigation import navigator
 from py_trees.common import Status
 
@@ -66,6 +67,32 @@ def test_uav_completes_a_frontier_within_the_blacklist_radius(tunnel, tunnel_poi
     node = FollowFrontierGoal("follow", ctx, tolerance_m=0.5)
     assert run(node, ctx, robot, ticks=40) == Status.SUCCESS
     assert events(ctx, "csiro_goal_done")[0]["why"] == "complete" and key[1] in st.blacklist
+
+
+def test_a_completed_uav_frontier_stays_blacklisted_until_it_is_updated(tunnel, tunnel_points):
+    grid, a, _ = tunnel
+    robot = FakeRobot(grid, a + np.array([18.0, 0.0, 1.5]), platform="aerial")
+    ctx = make_ctx(robot)
+    sweep(robot, tunnel_points)
+    UpdateFrontiers("update", ctx).tick_once()
+    select = SelectUavFrontier("select", ctx)
+    select.tick_once()
+    st = csiro_state(ctx)
+    key = py_trees.blackboard.Blackboard.storage["/r1/csiro_goal"]
+    assert run(FollowFrontierGoal("follow", ctx, tolerance_m=0.5), ctx, robot, ticks=40) == Status.SUCCESS
+    assert events(ctx, "csiro_goal_done")[0]["why"] == "complete"
+    f = next(f for f in st.frontiers.frontiers if f.id == key[1])
+    st.frontiers.discard([g.id for g in st.frontiers.frontiers if g.id != key[1]])   # only this one is left
+    away = (robot.position - f.mean) * [1.0, 1.0, 0.0]
+    robot._pos = robot.position + 2.0 * away / np.linalg.norm(away)        # back out of eta_blacklist of it
+    assert np.linalg.norm(robot.position - f.mean) > 3.0
+    st.momentum = None
+    select.tick_once()
+    assert select.status != Status.SUCCESS                        # complete, and unchanged: not again
+    on = -1.5 * away / np.linalg.norm(away)                      # Algorithm 2 updated it, 1.5 m on, same id
+    st.frontiers._frontiers[key[1]] = replace(f, mean=f.mean + on, points=f.points + on)
+    select.tick_once()
+    assert select.status == Status.SUCCESS and py_trees.blackboard.Blackboard.storage["/r1/csiro_goal"] == key
 
 
 def test_an_observer_beyond_the_onboard_map_s_graph_is_approached_as_near_as_it_reaches(tunnel):
@@ -135,12 +162,14 @@ def test_a_uav_short_of_its_frontier_on_a_stale_graph_goes_on_to_the_place_the_r
     wall[grid.to_index(np.array([a + [13.0, 0.0, 0.0]]))[0, 0], :, :] = True      # behind the robot
     free = grid.occupancy == FREE
     robot.onboard_map.write(wall & free, UNKNOWN)               # the graph is built with a gap in the map
-    SelectUavFrontier("select", ctx).tick_once()
-    robot.onboard_map.write(wall & free, FREE)                  # then seen open
     st = csiro_state(ctx)
-    key = py_trees.blackboard.Blackboard.storage["/r1/csiro_goal"]
-    centre = next(f.mean for f in st.frontiers.frontiers if f.id == key[1])
+    behind = min(st.frontiers.frontiers, key=lambda f: f.mean[0])
+    centre = behind.mean
     assert centre[0] < a[0] + 11.0                              # the frontier behind, beyond the wall's place
+    stale = reachable_near(ctx, robot, centre)[1]               # the goal selected on that graph
+    py_trees.blackboard.Blackboard.storage["/r1/csiro_goal"] = ["r1", behind.id]
+    py_trees.blackboard.Blackboard.storage["/r1/goal"] = stale.tolist()
+    robot.onboard_map.write(wall & free, FREE)                  # then seen open
     first = np.array(py_trees.blackboard.Blackboard.storage["/r1/goal"])
     assert first[0] > a[0] + 13.0                               # the stale graph's nearest place
     node = FollowFrontierGoal("follow", ctx, tolerance_m=0.5)

@@ -9,6 +9,7 @@ from delve.planners.csiro.frontier_types import Frontier
 from delve.planners.csiro.sharing import FrontierSummary
 from delve.planners.occupancy import OCCUPIED
 from delve.skills.csiro import SelectUavFrontier, SelectUgvFrontier, UpdateFrontiers, csiro_state
+from delve.skills.navigation import navigator
 from py_trees.common import Status
 
 from ..fakes import FakeRobot, bb, body, events, make_ctx, run
@@ -96,7 +97,7 @@ def test_uav_flies_for_its_own_frontier_and_skips_blacklisted_ones(tunnel, tunne
     frontier = next(f for f in st.frontiers.frontiers if f.id == first[1])
     goal = np.asarray(bb("goal"))
     assert np.linalg.norm(goal - frontier.mean) < np.linalg.norm(robot.position - frontier.mean)
-    st.blacklist.add(first[1])
+    st.blacklist.add(frontier)
     node.tick_once()
     assert node.status == Status.SUCCESS and bb("csiro_goal") != first
 
@@ -124,3 +125,53 @@ def test_uav_blacklists_a_frontier_wholly_in_its_blind_cones_behind_mapped_rock(
                                           normals=np.array([[0, 1.0, 0]] * 2), areas=np.array([20.0, 5.0]))
     node.tick_once()
     assert bb("csiro_goal")[1] == 99 and 99 not in st.blacklist
+
+
+def test_uav_skips_a_frontier_whose_centre_no_reachable_place_comes_within_eta_blacklist_of(tunnel, tunnel_points):
+    grid, a, _ = tunnel
+    robot = FakeRobot(grid, a + np.array([18.0, 0.0, 1.5]), platform="aerial")
+    ctx = make_ctx(robot)
+    sweep(robot, tunnel_points)
+    UpdateFrontiers("update", ctx).tick_once()
+    st = csiro_state(ctx)
+    in_rock = a + np.array([19.0, 7.0, 1.5])                  # 5 m beyond the wall at y + 2, level with the robot
+    big = Frontier(id=99, points=in_rock[None], normals=np.array([[0.0, 1.0, 0.0]]), areas=np.array([25.0]),
+                   mean=in_rock, cov=np.diag([4.0, 0.01, 4.0]))
+    st.frontiers._frontiers[99] = big                          # the largest, nearest: eq. 16 would take it
+    node = SelectUavFrontier("select", ctx)
+    node.tick_once()
+    assert node.status == Status.SUCCESS and bb("csiro_goal")[1] != 99
+    assert 99 not in st.blacklist                              # skipped, not blacklisted: the map may open
+    assert events(ctx, "csiro_frontier_out_of_reach")[0]["id"] == 99
+    within = a + np.array([19.0, 3.5, 1.5])                    # 1.5 m beyond the wall: a place within 3 m
+    st.momentum = None
+    st.frontiers._frontiers[99] = replace(big, points=within[None], mean=within)
+    node.tick_once()
+    assert bb("csiro_goal")[1] == 99
+
+
+def test_uav_searches_an_out_of_reach_frontier_s_version_once_on_a_rebuilt_graph(tunnel, tunnel_points):
+    grid, a, _ = tunnel
+    robot = FakeRobot(grid, a + np.array([18.0, 0.0, 1.5]), platform="aerial")
+    ctx = make_ctx(robot)
+    sweep(robot, tunnel_points)
+    UpdateFrontiers("update", ctx).tick_once()
+    st, nav = csiro_state(ctx), navigator(ctx, robot)
+    in_rock = a + np.array([19.0, 7.0, 1.5])                  # 5 m beyond the wall: out of reach
+    big = Frontier(id=99, points=in_rock[None], normals=np.array([[0.0, 1.0, 0.0]]), areas=np.array([25.0]),
+                   mean=in_rock, cov=np.diag([4.0, 0.01, 4.0]))
+    st.frontiers._frontiers[99] = big
+    node = SelectUavFrontier("select", ctx)
+    node.tick_once()
+    builds = nav.builds
+    for _ in range(3):                                          # the map changes, the frontier does not
+        robot.onboard_map.version += 1
+        st.momentum = None                                      # eq. 16 takes 99 first again
+        node.tick_once()
+        assert node.status == Status.SUCCESS and bb("csiro_goal")[1] != 99
+    assert nav.builds == builds                                 # no rebuild for a version already searched
+    robot.onboard_map.version += 1
+    st.frontiers._frontiers[99] = replace(big, cov=np.diag([4.0, 0.02, 4.0]))   # a new version of it
+    st.momentum = None
+    node.tick_once()
+    assert nav.builds == builds + 1 and bb("csiro_goal")[1] != 99
