@@ -82,13 +82,19 @@ def test_no_frontier_waits_then_ends_exploration(tunnel):
     assert len(events(ctx, "csiro_no_frontier")) == 1 and bb("csiro_goal") is None
 
 
-def test_uav_flies_for_its_own_frontier_and_skips_blacklisted_ones(tunnel, tunnel_points):
-    grid, a, _ = tunnel
+def uav_with_frontiers(grid, a, tunnel_points):
+    """A flying robot 18 m into the tunnel, its sweep integrated and its frontiers updated:
+    (robot, ctx, its CSIRO state)."""
     robot = FakeRobot(grid, a + np.array([18.0, 0.0, 1.5]), platform="aerial")
     ctx = make_ctx(robot)
     sweep(robot, tunnel_points)
     UpdateFrontiers("update", ctx).tick_once()
-    st = csiro_state(ctx)
+    return robot, ctx, csiro_state(ctx)
+
+
+def test_uav_flies_for_its_own_frontier_and_skips_blacklisted_ones(tunnel, tunnel_points):
+    grid, a, _ = tunnel
+    robot, ctx, st = uav_with_frontiers(grid, a, tunnel_points)
     node = SelectUavFrontier("select", ctx)
     node.tick_once()
     assert node.status == Status.SUCCESS
@@ -104,11 +110,7 @@ def test_uav_flies_for_its_own_frontier_and_skips_blacklisted_ones(tunnel, tunne
 
 def test_uav_blacklists_a_frontier_wholly_in_its_blind_cones_behind_mapped_rock(tunnel, tunnel_points):
     grid, a, _ = tunnel
-    robot = FakeRobot(grid, a + np.array([18.0, 0.0, 1.5]), platform="aerial")
-    ctx = make_ctx(robot)
-    sweep(robot, tunnel_points)
-    UpdateFrontiers("update", ctx).tick_once()
-    st = csiro_state(ctx)
+    robot, ctx, st = uav_with_frontiers(grid, a, tunnel_points)
     beyond = a + np.array([18.0, 0.0, 5.0])                  # straight up (blind), through the roof
     assert grid.value_at(a[None] + [[18.0, 0.0, 3.1]])[0] == OCCUPIED
     big = Frontier(id=99, points=beyond[None], normals=np.array([[0.0, 0.0, 1.0]]), areas=np.array([25.0]),
@@ -129,11 +131,7 @@ def test_uav_blacklists_a_frontier_wholly_in_its_blind_cones_behind_mapped_rock(
 
 def test_uav_skips_a_frontier_whose_centre_no_reachable_place_comes_within_eta_blacklist_of(tunnel, tunnel_points):
     grid, a, _ = tunnel
-    robot = FakeRobot(grid, a + np.array([18.0, 0.0, 1.5]), platform="aerial")
-    ctx = make_ctx(robot)
-    sweep(robot, tunnel_points)
-    UpdateFrontiers("update", ctx).tick_once()
-    st = csiro_state(ctx)
+    robot, ctx, st = uav_with_frontiers(grid, a, tunnel_points)
     in_rock = a + np.array([19.0, 7.0, 1.5])                  # 5 m beyond the wall at y + 2, level with the robot
     big = Frontier(id=99, points=in_rock[None], normals=np.array([[0.0, 1.0, 0.0]]), areas=np.array([25.0]),
                    mean=in_rock, cov=np.diag([4.0, 0.01, 4.0]))
