@@ -28,3 +28,17 @@ def sweep(robot, points: np.ndarray, range_m: float = 30.0) -> None:
     """Give ``robot`` one LiDAR sweep: the ``points`` within ``range_m`` of it, seen from it."""
     near = points[np.linalg.norm(points - robot.position, axis=1) <= range_m]
     robot.lidar_scans.append(SimpleNamespace(sensor=robot.position, points=near))
+
+
+def uav_with_frontiers(grid, a, tunnel_points):
+    """A flying robot 18 m into the tunnel, its sweep integrated and its frontiers updated:
+    (robot, ctx, its CSIRO state)."""
+    from delve.skills.csiro import UpdateFrontiers, csiro_state
+
+    from ..fakes import FakeRobot, make_ctx
+
+    robot = FakeRobot(grid, a + np.array([18.0, 0.0, 1.5]), platform="aerial")
+    ctx = make_ctx(robot)
+    sweep(robot, tunnel_points)
+    UpdateFrontiers("update", ctx).tick_once()
+    return robot, ctx, csiro_state(ctx)

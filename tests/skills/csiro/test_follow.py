@@ -7,14 +7,13 @@ from dataclasses import replace
 import numpy as np
 import py_trees
 from delve.planners.occupancy import FREE, OCCUPIED, UNKNOWN
-from delve.skills.csiro import FollowFrontierGoal, SelectUavFrontier, SelectUgvFrontier, UpdateFrontiers, \
-    csiro_state
+from delve.skills.csiro import FollowFrontierGoal, SelectUavFrontier, SelectUgvFrontier
 from delve.skills.csiro.follow import reachable_near
 from delve.skills.navigation import navigator
 from py_trees.common import Status
 
-from ..fakes import FakeRobot, events, make_ctx, run
-from .conftest import sweep
+from ..fakes import events, run
+from .conftest import uav_with_frontiers
 from .test_selection import ground_robot, summary
 
 
@@ -57,12 +56,8 @@ def test_explored_frontier_ends_the_goal(tunnel):
 
 def test_uav_completes_a_frontier_within_the_blacklist_radius(tunnel, tunnel_points):
     grid, a, _ = tunnel
-    robot = FakeRobot(grid, a + np.array([18.0, 0.0, 1.5]), platform="aerial")
-    ctx = make_ctx(robot)
-    sweep(robot, tunnel_points)
-    UpdateFrontiers("update", ctx).tick_once()
+    robot, ctx, st = uav_with_frontiers(grid, a, tunnel_points)
     SelectUavFrontier("select", ctx).tick_once()
-    st = csiro_state(ctx)
     key = py_trees.blackboard.Blackboard.storage["/r1/csiro_goal"]
     node = FollowFrontierGoal("follow", ctx, tolerance_m=0.5)
     assert run(node, ctx, robot, ticks=40) == Status.SUCCESS
@@ -71,13 +66,9 @@ def test_uav_completes_a_frontier_within_the_blacklist_radius(tunnel, tunnel_poi
 
 def test_a_completed_uav_frontier_stays_blacklisted_until_it_is_updated(tunnel, tunnel_points):
     grid, a, _ = tunnel
-    robot = FakeRobot(grid, a + np.array([18.0, 0.0, 1.5]), platform="aerial")
-    ctx = make_ctx(robot)
-    sweep(robot, tunnel_points)
-    UpdateFrontiers("update", ctx).tick_once()
+    robot, ctx, st = uav_with_frontiers(grid, a, tunnel_points)
     select = SelectUavFrontier("select", ctx)
     select.tick_once()
-    st = csiro_state(ctx)
     key = py_trees.blackboard.Blackboard.storage["/r1/csiro_goal"]
     assert run(FollowFrontierGoal("follow", ctx, tolerance_m=0.5), ctx, robot, ticks=40) == Status.SUCCESS
     assert events(ctx, "csiro_goal_done")[0]["why"] == "complete"
@@ -154,15 +145,11 @@ def test_an_observer_beyond_a_stale_navigation_graph_is_planned_on_the_graph_reb
 def test_a_uav_short_of_its_frontier_on_a_stale_graph_goes_on_to_the_place_the_rebuilt_graph_reaches(
         tunnel, tunnel_points):
     grid, a, _ = tunnel
-    robot = FakeRobot(grid, a + np.array([18.0, 0.0, 1.5]), platform="aerial")
-    ctx = make_ctx(robot)
-    sweep(robot, tunnel_points)
-    UpdateFrontiers("update", ctx).tick_once()
+    robot, ctx, st = uav_with_frontiers(grid, a, tunnel_points)
     wall = np.zeros(grid.shape, bool)
     wall[grid.to_index(np.array([a + [13.0, 0.0, 0.0]]))[0, 0], :, :] = True      # behind the robot
     free = grid.occupancy == FREE
     robot.onboard_map.write(wall & free, UNKNOWN)               # the graph is built with a gap in the map
-    st = csiro_state(ctx)
     behind = min(st.frontiers.frontiers, key=lambda f: f.mean[0])
     centre = behind.mean
     assert centre[0] < a[0] + 11.0                              # the frontier behind, beyond the wall's place

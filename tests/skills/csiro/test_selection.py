@@ -13,7 +13,7 @@ from delve.skills.navigation import navigator
 from py_trees.common import Status
 
 from ..fakes import FakeRobot, bb, body, events, make_ctx, run
-from .conftest import sweep
+from .conftest import sweep, uav_with_frontiers
 
 
 def summary(owner: str, fid: int, x: float, reward: float = 10.0) -> FrontierSummary:
@@ -80,16 +80,6 @@ def test_no_frontier_waits_then_ends_exploration(tunnel):
     assert run(node, ctx, robot, ticks=3) == Status.RUNNING
     assert run(node, ctx, robot, ticks=10) == Status.FAILURE
     assert len(events(ctx, "csiro_no_frontier")) == 1 and bb("csiro_goal") is None
-
-
-def uav_with_frontiers(grid, a, tunnel_points):
-    """A flying robot 18 m into the tunnel, its sweep integrated and its frontiers updated:
-    (robot, ctx, its CSIRO state)."""
-    robot = FakeRobot(grid, a + np.array([18.0, 0.0, 1.5]), platform="aerial")
-    ctx = make_ctx(robot)
-    sweep(robot, tunnel_points)
-    UpdateFrontiers("update", ctx).tick_once()
-    return robot, ctx, csiro_state(ctx)
 
 
 def test_uav_flies_for_its_own_frontier_and_skips_blacklisted_ones(tunnel, tunnel_points):
