@@ -169,9 +169,6 @@ class UavBlacklist:
         """Whether an entry of ``frontier_id`` exists (whether or not that version is current)."""
         return frontier_id in self._versions
 
-    def __len__(self) -> int:
-        return len(self._versions)
-
     def clear(self) -> None:
         self._versions.clear()
 
