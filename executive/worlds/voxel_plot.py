@@ -9,11 +9,11 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from scipy.ndimage import binary_dilation, find_objects, label, maximum_filter1d  # noqa: E402
 
-from ...planners.frontier import (MAX_GOAL_OFFSET_M, VIEWPOINT_SPACING_M, frontier_voxels,  # noqa: E402
-                                  observable_frontiers, viewpoint_nodes)
-from ...planners.occupancy import Grid  # noqa: E402
-from ...skills.navigation import navigator  # noqa: E402
+from ...planners.frontier import FRONTIER_DEPTH, frontier_voxels  # noqa: E402
+from ...planners.navgraph import FACES, Voxels  # noqa: E402
+from ...planners.occupancy import OCCUPIED, UNKNOWN, Grid  # noqa: E402
 
 if TYPE_CHECKING:
     from ..runner import Mission
@@ -23,27 +23,91 @@ def _top_down(mask: np.ndarray) -> np.ndarray:
     return mask.any(axis=2).T
 
 
-def frontiers_left(mission: "Mission", name: str) -> np.ndarray:
-    """World centres of the frontier voxels of robot ``name``'s map that its sensor could
-    still observe from a node it can reach (what its frontier explorer would still
-    go to: :func:`~delve.planners.frontier.observable_frontiers`); all frontier voxels
-    when the robot is off its navigation graph."""
-    robot = mission.robots[name]
-    m = robot.onboard_map
-    grid = Grid(m.occupancy, m.origin, m.voxel_size_m)
-    front = frontier_voxels(grid)
-    agent = mission.agents.get(name)
-    plan = navigator(agent.ctx, robot).from_robot(force=True) if agent is not None else None
-    if plan is not None:
-        views = plan.graph.positions[viewpoint_nodes(plan.graph, plan.distances, VIEWPOINT_SPACING_M)]
-        front = observable_frontiers(grid, front, views, view_up_deg=robot.view_up_deg,
-                                     reach_m=MAX_GOAL_OFFSET_M)
-    return grid.to_world(np.stack(np.unravel_index(front, m.shape), axis=1))
+#: A column counts as seen at a height when the team knows one of its voxels (free or rock)
+#: within this much above or below (m): a drift's height, well under the 12-15 m between
+#: the levels of a two-level mine.
+SEEN_BAND_M = 3.0
+#: Open edges shorter than this (m, in the top view) are not drawn: the single columns at
+#: the corners of a wall's voxel steps that no ray reached.
+MIN_EDGE_M = 1.0
+#: Columns beyond a frontier voxel that must be unseen for it to open onto unseen ground:
+#: the explorers' :data:`~delve.planners.frontier.FRONTIER_DEPTH` and two more.
+OPEN_STRIP = FRONTIER_DEPTH + 2
+
+
+def seen_ground(maps: list[np.ndarray], voxel_size_m: float, band_m: float = SEEN_BAND_M) -> np.ndarray:
+    """Whether the team (occupancy grids ``maps``, one shape) knows some voxel of each
+    voxel's column within ``band_m`` above or below it: the ground a top view shows as seen."""
+    known = np.zeros(maps[0].shape, dtype=bool)
+    for occupancy in maps:
+        known |= occupancy != UNKNOWN
+    return maximum_filter1d(known, size=2 * round(band_m / voxel_size_m) + 1, axis=2)
+
+
+def open_frontiers(grid: Grid, voxels: np.ndarray, seen: np.ndarray, rock: np.ndarray) -> np.ndarray:
+    """The frontier ``voxels`` (flat indices of ``grid``) that open sideways onto ground nobody
+    saw: along one of the four horizontal faces, the columns beyond the voxel in a strip
+    :data:`OPEN_STRIP` deep and three wide are unseen at its height (``seen``:
+    :func:`seen_ground`; beyond the grid counts as seen), and no map of the team holds the
+    voxel as rock (``rock``: a ray that grazed a wall leaves its surface free in one map, a
+    wall in another). Three wide, because a diagonal wall's voxels touch only at their edges.
+
+    Why: a top view shows which ground was seen, and a frontier tells its reader something
+    only where the seen area ends in unseen ground (a tunnel's mouth, the far end of a drift
+    seen from afar, a branch). Drawn, the unknown straight above or below seen ground (a
+    roof the legged robot's 30° LiDAR never saw, a floor under a flying robot) and behind
+    walls carpeted explored drifts with dots. The explorers' minimum cluster size
+    (``frontier_clusters``, 10 voxels) does not tell them apart: a carpet under a roof is
+    one large cluster, and at 0.4 m voxels the rays' stripes at a drift's far end are small
+    ones. A shaft's mouth in a seen roof or floor is not drawn either: a top view cannot
+    show it apart from the drift around it."""
+    v = Voxels(voxels, grid.shape)
+    flat_seen = seen.reshape(-1)
+    opens = np.zeros(len(voxels), dtype=bool)
+    for dx, dy, _ in FACES[:4]:
+        unseen = np.ones(len(voxels), dtype=bool)
+        for k in range(1, OPEN_STRIP + 1):
+            for side in (-1, 0, 1):   # across: (dy, -dx)
+                unseen &= ~v.at(flat_seen, (dx * k + dy * side, dy * k - dx * side, 0), True)
+        opens |= unseen
+    return voxels[opens & ~rock.reshape(-1)[voxels]]
+
+
+def long_edges(columns: np.ndarray, voxel_size_m: float, min_length_m: float = MIN_EDGE_M) -> np.ndarray:
+    """The ``columns`` (a top view's mask) in groups at least ``min_length_m`` long (along x or
+    y); columns with up to two others between them join a group (at a drift's far end, the
+    rays' stripes end one or two unseen columns apart)."""
+    labels, _ = label(binary_dilation(columns, np.ones((3, 3), dtype=bool)))
+    labels = np.where(columns, labels, 0)
+    length = [max(s.stop - s.start for s in box) * voxel_size_m for box in find_objects(labels)]
+    keep = np.array([False] + [n >= min_length_m for n in length])
+    return keep[labels]
+
+
+def frontiers_left(mission: "Mission") -> np.ndarray:
+    """(N, 2) world x, y of the columns drawn as frontiers left: each robot's frontier voxels
+    that open onto ground the team did not see (:func:`open_frontiers`), seen from above, in
+    edges of at least :data:`MIN_EDGE_M` (:func:`long_edges`)."""
+    maps = [robot.onboard_map for robot in mission.robots.values()]
+    if not maps:
+        return np.zeros((0, 2))
+    seen = seen_ground([m.occupancy for m in maps], maps[0].voxel_size_m)
+    rock = np.zeros(maps[0].shape, dtype=bool)
+    for m in maps:
+        rock |= m.occupancy == OCCUPIED
+    columns = np.zeros(maps[0].shape[:2], dtype=bool)
+    for m in maps:
+        grid = Grid(m.occupancy, m.origin, m.voxel_size_m)
+        i, j, _ = np.unravel_index(open_frontiers(grid, frontier_voxels(grid), seen, rock), grid.shape)
+        columns[i, j] = True
+    ij = np.argwhere(long_edges(columns, maps[0].voxel_size_m))
+    return np.asarray(maps[0].origin)[:2] + (ij + 0.5) * maps[0].voxel_size_m
 
 
 def plot_voxel_map(mission: "Mission", truth_voxels: np.ndarray, path: Path) -> None:
-    """Top-down map: free space, what the team saw, walls, paths, the frontiers left at
-    the end (:func:`frontiers_left`), radio links."""
+    """Top-down map: free space, what the team saw, walls, paths (flying robots' dashed, on
+    top), the frontiers left at the end that open onto unseen ground (:func:`frontiers_left`),
+    radio links (under the paths)."""
     world = mission.world
     extent = (world.origin[0], world.origin[0] + world.free.shape[0] * world.voxel_size_m,
               world.origin[1], world.origin[1] + world.free.shape[1] * world.voxel_size_m)
@@ -63,13 +127,21 @@ def plot_voxel_map(mission: "Mission", truth_voxels: np.ndarray, path: Path) -> 
     colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     for i, (name, robot) in enumerate(mission.robots.items()):
         trail = robot.traversed_path
-        ax.plot(trail[:, 0], trail[:, 1], "-", lw=1.3, color=colours[i % len(colours)], label=f"{name} path")
-        pts = frontiers_left(mission, name)[::5]
-        if len(pts):
-            ax.plot(pts[:, 0], pts[:, 1], ".", ms=1.5, color="red", label="frontiers left" if i == 0 else None)
+        aerial = robot.mobility.aerial
+        # A flying robot's path dashed and above the ground robots' solid ones: where it flew
+        # over a ground robot's path, that path shows between its dashes.
+        ax.plot(trail[:, 0], trail[:, 1], ls=(0, (4, 2.5)) if aerial else "-", lw=1.3,
+                color=colours[i % len(colours)], zorder=2.2 if aerial else 2.0,
+                label=f"{name} path (flying)" if aerial else f"{name} path")
+    left = frontiers_left(mission)
+    ax.plot(left[:, 0], left[:, 1], ".", ms=2, color="red", zorder=3,
+            label=f"frontiers left: where the seen area opens\nonto unseen ground (edges >= {MIN_EDGE_M:g} m)"
+            if len(left) else "no frontiers left: the seen area nowhere\nopens onto unseen ground")
+    for i, name in enumerate(mission.robots):
         pos = np.array([s.positions[name] for s in mission.state.samples])
         linked = np.array([s.linked[name] for s in mission.state.samples])
-        ax.plot(pos[linked, 0], pos[linked, 1], "o", ms=3, color="green", label="radio link to base" if i == 0 else None)
+        ax.plot(pos[linked, 0], pos[linked, 1], "o", ms=3, color="green", zorder=1.9,   # under the paths
+                label="radio link to base" if i == 0 else None)
     ax.plot(*mission.base_position[:2], "k^", ms=9, label="base station")
     mission.artifacts.draw(ax, mission)
     mission.team.draw(ax, mission)
