@@ -137,7 +137,8 @@ class CohortHub:
         share points with another robot's latest assignment while it holds (T_C + T_C^e
         after it was given: a robot that has not called again by then has gone home or
         lost its way back) as held by it, and the other robots holding none that the
-        hub heard from (a submap made or a call) in that time as free.
+        hub heard from (a submap made or a call) in that time as free, but for those
+        it answered without a frontier less than T_C before (:meth:`told_none`).
         Recomputes the frontiers first when a submap arrived since. The answer is
         recorded."""
         if self.stale:
@@ -153,7 +154,8 @@ class CohortHub:
         busy = set().union(*holders.values()) if holders else set()
         hold = self.params.period_s + self.params.extra_explore_s
         free = [n for n, heard in sorted(self.last_heard_s.items())
-                if n not in (robot, HOME) and n not in busy and t_s - heard <= hold]
+                if n not in (robot, HOME) and n not in busy and t_s - heard <= hold
+                and not self.told_none(n, t_s)]
         lo, hi = self.common.bounds
         result = choose_frontier(self.graph, self.clusters, self.links, entries, robot,
                                  best_share_pct=self.params.best_share_pct, box_m=self.params.box_m,
@@ -163,6 +165,15 @@ class CohortHub:
         self.assignments.append(record)
         self.last_assignment[robot] = record
         return result
+
+    def told_none(self, robot: str, t_s: float) -> bool:
+        """Whether ``robot``'s latest answer, given less than T_C before ``t_s``, had no
+        frontier: it explores on with its own GBPlanner2 and calls again only T_C after
+        that answer, so it is not waiting for a cluster now. (Counted as free, two robots
+        that call in turn could each be told none in favour of the other, as both
+        robots' positions change with their calls, and the cluster would go to neither.)"""
+        rec = self.last_assignment.get(robot)
+        return rec is not None and not rec.result.ok and t_s - rec.t_s < self.params.period_s
 
     def holders(self, robot: str, t_s: float) -> dict[int, set[str]]:
         """Per current cluster (index), the robots other than ``robot`` whose latest

@@ -124,7 +124,8 @@ class CallHub(Skill):
     nothing to give) those are null and the box is lifted, so that GBPlanner2 explores
     on its own. A frontier within ``repeat_radius_m`` of the last target, when the
     robot found that box explored (``exploration_complete``), counts as none (reason
-    ``repeated``): the hub's frontier is one the robot's sensors cannot clear.
+    ``repeated``): the hub's frontier is one the robot's sensors cannot clear. A call
+    that fails sets ``cohort_goal`` to null (nothing to follow) and keeps the box.
 
     Logs ``cohort_call`` (reached or not) and ``cohort_assignment_received``.
     Returns RUNNING while waiting for the answer; SUCCESS when it came; FAILURE when
@@ -151,7 +152,7 @@ class CallHub(Skill):
                                               "oldest first"),
         "cohort_target": PortInformation(list | None, description="[x, y, z] the frontier assigned; null: none"),
         "cohort_goal": PortInformation(list | None, description="[x, y, z] where the re-positioning path ends; null: "
-                                       "no frontier"),
+                                       "no frontier, or the last call failed"),
         "cohort_path": PortInformation(list | None, description="[[x, y, z], ...] the hub's path along G_C"),
         "exploration_bbox": PortInformation(dict | None, description="{min, max}: the box D around the frontier; "
                                             "null: no box"),
@@ -175,6 +176,7 @@ class CallHub(Skill):
             if not linked(r.radio, self.p["ping_attempts"]):
                 self.feedback_message = "hub out of reach"
                 self.event("cohort_call", reached=False, position=xyz(r.position, 2))
+                self.write("cohort_goal", None)
                 return Status.FAILURE
             self._remember_link_point(r.position)
             # One count per agent: a tree may call the hub from several places.
@@ -190,6 +192,7 @@ class CallHub(Skill):
         if now - self.asked_s >= self.p["answer_timeout_s"]:
             self.feedback_message = f"no answer to request {self.request_id}"
             self.event("cohort_call_unanswered", request_id=self.request_id)
+            self.write("cohort_goal", None)
             return Status.FAILURE
         self.feedback_message = f"waiting for the hub (request {self.request_id})"
         return Status.RUNNING

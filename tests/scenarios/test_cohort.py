@@ -50,6 +50,24 @@ def test_the_hub_sends_two_robots_into_different_branches_of_a_fork():
         assert y.max() > 10.0 and y.min() > -3.0, r
 
 
+def test_the_robots_explore_on_while_they_call_and_only_a_frontier_stops_the_explorer():
+    mission, _ = run_scenario(DATA / "cohort_fork.yaml")
+    for r in ("a", "b"):
+        events = [e for e in mission.state.events if e.get("agent") == r]
+        halted = {e["t"] for e in events if e["event"] == "status" and e["node"] == "Explore (GBPlanner2)"
+                  and e["old"] == "RUNNING" and e["new"] == "INVALID"}
+        calls = {e["request_id"]: e for e in events if e["event"] == "cohort_call" and e["reached"]
+                 and e["node"] == "Call the hub while exploring"}
+        answers = [e for e in events
+                   if e["event"] == "cohort_assignment_received" and e["request_id"] in calls]
+        assert answers, r
+        for answer in answers:
+            call = calls[answer["request_id"]]
+            assert answer["t"] > call["t"], (r, call)
+            assert not any(call["t"] <= t < answer["t"] for t in halted), (r, call)
+            assert (answer["t"] in halted) == (answer["frontier"] is not None), (r, answer)
+
+
 def test_same_seed_same_report_and_log(tmp_path):
     _, a = run_scenario(DATA / "cohort_fork.yaml", tmp_path / "a")
     _, b = run_scenario(DATA / "cohort_fork.yaml", tmp_path / "b")

@@ -92,3 +92,26 @@ def test_clusters_held_by_others_and_free_robots_heard_from_lately_reach_the_cho
     hold = PARAMS.period_s + PARAMS.extra_explore_s
     hub.reposition(fine, "c", at, hold + 1.0)   # "b" silent since t = 0; "a" still holds
     assert seen["holders"] == {ra.cluster: {"a"}} and seen["free"] == []
+
+
+def test_a_robot_just_answered_without_a_frontier_is_not_waiting_for_one(monkeypatch):
+    """Two robots call in turn for the trunk's one frontier, each nearer to it than the
+    other where the hub last placed it: the first is told none (the second, placed by
+    its submap, is nearer); the second, calling from farther back, then gets it rather
+    than leaving it to the first, which explores on its own until its next call, T_C
+    later (from then on it counts as free again)."""
+    import delve.planners.cohort.hub as hub_module
+
+    hub, fine = hub_after(TRUNK, ("b", 0, 0, 10, [[3, 20, Z], [19, 20, Z]]))
+    hub.update_frontiers()
+    assert len(hub.clusters) == 1
+    ra = hub.reposition(fine, "a", np.array([10, 20, Z]), 10.0)
+    rb = hub.reposition(fine, "b", np.array([4, 20, Z]), 11.0)
+    assert ra.reason == "taken" and rb.ok
+    seen = {}
+    real = hub_module.choose_frontier
+    monkeypatch.setattr(hub_module, "choose_frontier", lambda *a, **kw: seen.update(kw) or real(*a, **kw))
+    hub.reposition(fine, "c", np.array([4, 20, Z]), 10.0 + PARAMS.period_s - 1.0)
+    assert seen["free"] == []
+    hub.reposition(fine, "c", np.array([4, 20, Z]), 10.0 + PARAMS.period_s + 1.0)
+    assert seen["free"] == ["a"]

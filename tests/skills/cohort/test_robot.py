@@ -170,6 +170,20 @@ def test_no_answer_in_time_fails_and_the_next_call_asks_again(robot):
     assert len(bb("cohort_link_points")) == 1  # the same place
 
 
+@pytest.mark.parametrize("link_up", [False, True])
+def test_a_failed_call_leaves_nothing_to_follow_and_keeps_the_box(robot, link_up):
+    """Out of reach, or unanswered: the goal of an earlier answer is not followed again
+    (the cycle reads a goal as a frontier just given), the box stays for the lost-link rule."""
+    ctx = ctx_for(robot)
+    box = {"min": [0.0, -5.0, 0.0], "max": [60.0, 5.0, 4.0]}
+    py_trees.blackboard.Blackboard.set("/r1/cohort_goal", [30.0, 0.0, 1.5])
+    py_trees.blackboard.Blackboard.set("/r1/exploration_bbox", box)
+    robot.radio.link_up = link_up
+    node = CallHub(name="Call", ctx=ctx, answer_timeout_s=5.0)
+    assert tick(node, ctx, robot, 6) == Status.FAILURE
+    assert bb("cohort_goal") is None and bb("exploration_bbox") == box
+
+
 # --------------------------------------------------------------------- FollowHubPath
 
 
