@@ -22,7 +22,11 @@ EIGEN_SPAN, EIGEN_SCALE = 2.0, 5.0
 class GoalProgress:
     """Progress towards one goal (Algorithm 3): navigation has failed once the closest
     approach to ``goal`` improved by less than ``progress_m`` over ``progress_window_s``.
-    Feed it ``update(t_s, position)`` at increasing times; failure is final."""
+    Feed it ``update(t_s, position)`` at increasing times; failure is final.
+
+    The approach is the distance still to go: along the path the robot follows when the caller
+    gives it (``distance_m``), else the straight line to ``goal``. Not the straight line alone: the
+    way to a frontier in another drift first leads away from it, and that is progress too."""
 
     def __init__(self, goal: np.ndarray, params: CsiroSelectionParams):
         self.goal = np.asarray(goal, float)
@@ -31,9 +35,11 @@ class GoalProgress:
         self.failed = False
         self._samples: deque[tuple[float, float]] = deque()  # (t_s, closest approach then)
 
-    def update(self, t_s: float, position: np.ndarray) -> bool:
-        """Record the robot at ``position`` at time ``t_s``; whether navigation has failed."""
-        self.closest_m = min(self.closest_m, float(np.linalg.norm(np.asarray(position, float) - self.goal)))
+    def update(self, t_s: float, position: np.ndarray, distance_m: float | None = None) -> bool:
+        """Record the robot at ``position`` at time ``t_s``, ``distance_m`` from the goal along its
+        path (default: the straight line); whether navigation has failed."""
+        to_go = float(np.linalg.norm(np.asarray(position, float) - self.goal)) if distance_m is None else distance_m
+        self.closest_m = min(self.closest_m, float(to_go))
         self._samples.append((t_s, self.closest_m))
         while len(self._samples) > 1 and self._samples[1][0] <= t_s - self.window_s:
             self._samples.popleft()  # keep one sample at or before the window's start

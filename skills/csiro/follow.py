@@ -10,9 +10,9 @@ from py_trees.ports import PortInformation
 
 from ...planners.csiro.selection import GoalProgress, uav_frontier_complete
 from ...planners.csiro.topometric import frontier_node
-from ...planners.geometry import xyz
+from ...planners.geometry import path_length, xyz
 from ..base import Param
-from ..motion import GoTo
+from ..motion import GoTo, goal_distance
 from ..navigation import navigator
 from .state import CsiroState, csiro_state
 
@@ -39,8 +39,10 @@ class FollowFrontierGoal(GoTo):
 
     A ground robot's first path is the topometric map's A* path to the frontier (other robots'
     trajectories cross space its own map lacks), re-planned like ``GoTo`` when blocked. Progress
-    is watched as Algorithm 3 says: when the closest approach to the goal improves by less than
-    ``progress_m`` in ``progress_window_s`` (1 m, 15 s), or the way cannot be planned (on the
+    is watched as Algorithm 3 says: when the closest approach to the goal (the distance still to go
+    along the robot's path, whose way to another drift first leads away) improves by less than
+    ``progress_m`` in ``progress_window_s`` (1 m, 15 s; counted afresh after an interruption such as
+    explore-sync), or the way cannot be planned (on the
     navigation graph rebuilt from the current map), or the robot's own frontier is still
     unchanged ``dwell_s`` after it reached the goal, the goal has failed: a ground robot's
     frontier gets the penalty rho_fail until it is updated and its observer joins the failed
@@ -50,7 +52,8 @@ class FollowFrontierGoal(GoTo):
     observer moved more than ``reselect_m`` from the goal, it changed while the robot stood at
     the goal (select again), a teammate's frontier's observer was reached (only its owner can
     update it; the place joins the robot's trajectory points, which discount it, equation 14),
-    or (flying robot) it came within eta_blacklist of its centre (complete, and blacklisted);
+    or (flying robot) it came within eta_blacklist of its centre (complete, and blacklisted; a
+    goal within that radius of the centre is flown to until then, not ``tolerance_m`` short);
     RUNNING on the way and while standing at the goal; FAILURE when the goal failed
     (``csiro_goal_failed`` in the log).
     """
@@ -93,7 +96,8 @@ class FollowFrontierGoal(GoTo):
         done = self._frontier_done(st)
         if done:
             return self._done(done)
-        if self.watch.update(self.ctx.clock.now_s, r.position):
+        to_go = self._to_go()
+        if to_go is not None and self.watch.update(self.ctx.clock.now_s, r.position, to_go):
             return self._failed(st, f"closest approach improved less than {self.watch.progress_m:g} m in "
                                     f"{self.watch.window_s:g} s")
         if self.goal is not None and self.reached():
@@ -103,6 +107,34 @@ class FollowFrontierGoal(GoTo):
         if status == Status.FAILURE:
             return self._failed(st, self.feedback_message)
         return Status.RUNNING if status == Status.SUCCESS else status
+
+    def reached(self) -> bool:
+        """``GoTo``'s arrival within ``tolerance_m`` of the goal; a flying robot whose goal lies within
+        eta_blacklist of its frontier's centre flies on until the frontier is complete (at the goal
+        at the latest) rather than standing up to ``tolerance_m`` short of it, out of that radius."""
+        if not super().reached():
+            return False
+        frontier = self._own_frontier() if self.robot.mobility.aerial else None
+        return frontier is None or not uav_frontier_complete(frontier, self.goal, csiro_state(self.ctx).selection)
+
+    def _to_go(self) -> float | None:
+        """The distance still to go for the progress rule: along the path while the robot follows
+        this behaviour's path, the straight line once it is at the goal; None before the first
+        path and between re-plans (the straight line would count a way through rock)."""
+        r = self.robot
+        if self.goal is None:
+            return None
+        rest = r.remaining_path if self.moving else np.zeros((0, 3))
+        if len(rest):
+            return path_length(np.vstack([r.position, rest, self.goal]))
+        return goal_distance(r, self.goal) if self.reached() else None
+
+    def terminate(self, new_status: Status) -> None:
+        """Interrupted while running (explore-sync took over): the progress watch starts afresh
+        when the frontier is selected again, as the time away was no lack of progress."""
+        if new_status == Status.INVALID and self.status == Status.RUNNING:
+            self.watch = None
+        super().terminate(new_status)
 
     def _at_goal(self, st: CsiroState) -> Status:
         """Standing at the goal: done when it is a teammate's frontier or the frontier changed,

@@ -10,7 +10,6 @@ from py_trees.common import Status
 from py_trees.ports import PortInformation
 
 from ...planners.csiro.frontier_types import Frontier
-from ...planners.csiro.observer import within_elevations
 from ...planners.csiro.selection import rank_uav_frontiers, select_ugv_frontier, uav_frontier_complete
 from ...planners.csiro.topometric import frontier_node
 from ...planners.geometry import xyz
@@ -93,9 +92,9 @@ class SelectUavFrontier(_Select):
     centre no such place comes within eta_blacklist of (a patch in rock or beyond a wall: the UAV
     could never complete it) is skipped at this selection (``csiro_frontier_out_of_reach``, once
     per frontier). A frontier
-    that lies wholly in its sensor's blind cones and behind rock of the onboard map seen from
-    that place (a patch beyond a roof or floor whose cached points left gaps) is blacklisted at
-    once (``csiro_frontier_behind_surface``) and the next one taken.
+    that lies wholly behind rock of the onboard map seen from that place (a patch beyond a roof,
+    floor or wall whose cached points left gaps: flying there would complete it unseen) is
+    blacklisted at once (``csiro_frontier_behind_surface``) and the next one taken.
 
     Writes ``goal`` and ``csiro_goal``. Returns SUCCESS with a goal; RUNNING while none is
     selectable, up to ``wait_s``; then FAILURE (exploration over).
@@ -118,9 +117,7 @@ class SelectUavFrontier(_Select):
                                nearest_m=round(float(np.linalg.norm(near[1] - frontier.mean)), 2))
                 continue
             place = r.position if near is None else near[1]
-            fp = st.frontier_params
-            if within_elevations(frontier.points - place, (fp.elevation_min_deg, fp.elevation_max_deg)).any() or \
-                    in_sight(r.onboard_map, place, frontier.points):
+            if in_sight(r.onboard_map, place, frontier.points):
                 break
             st.blacklist.add(frontier)
             self.event("csiro_frontier_behind_surface", id=frontier.id, centre=xyz(frontier.mean, 2))

@@ -64,6 +64,13 @@ def test_moving_away_is_no_progress():
     assert progress.update(15.0, np.array([50.0, 0.0, 0.0]))
 
 
+def test_the_distance_along_the_path_counts_though_the_robot_moves_away():
+    progress = GoalProgress(np.array([0.0, 10.0, 0.0]), P)     # the goal in the next drift, 10 m across
+    for t in np.arange(0.0, 40.0, 0.5):                       # 1 m/s away from it, then back along the next
+        assert not progress.update(t, np.array([t, 0.0, 0.0]), distance_m=60.0 - t)
+    assert progress.closest_m == pytest.approx(60.0 - 39.5)
+
+
 def test_failure_penalty_lasts_until_the_frontier_is_updated():
     failed = FailedFrontiers()
     s = summary("ugv1", 1, 10.0, [10.0, 0.0, 0.0], updated_s=5.0)

@@ -6,13 +6,14 @@ from dataclasses import replace
 
 import numpy as np
 import py_trees
+from delve.planners.csiro.frontier_types import Frontier
 from delve.planners.occupancy import FREE, OCCUPIED, UNKNOWN
 from delve.skills.csiro import FollowFrontierGoal, SelectUavFrontier, SelectUgvFrontier
 from delve.skills.csiro.follow import reachable_near
 from delve.skills.navigation import navigator
 from py_trees.common import Status
 
-from ..fakes import events, run
+from ..fakes import bb, events, run
 from .conftest import uav_with_frontiers
 from .test_selection import ground_robot, summary
 
@@ -45,6 +46,32 @@ def test_a_stuck_robot_fails_its_goal_after_the_progress_window(tunnel):
     assert events(ctx, "csiro_goal_failed")[0]["reason"].startswith("closest approach improved less than 1 m")
 
 
+def test_a_way_that_first_leads_away_from_a_distant_frontier_is_progress(tunnel):
+    robot, ctx, st = ground_robot(tunnel, ())                 # r1 walked from x = 7 to 45
+    for x in np.arange(45.0, 24.0, -1.0):
+        node = st.topometric.add_pose("r2", 100.0 - x, [x, 7.5, 1.5])   # r2 from x = 45 back to 25
+        if x == 45.0:
+            st.topometric.connect(st.topometric.last_node("r1"), node)
+    robot._pos = np.array([35.0, 6.0, 1.5])                   # the only way to x = 25 leads by x = 45
+    s = st.summaries[("r1", 0)] = summary("r1", 0, 25.0)
+    st.topometric.attach_frontier(s.key, "r2", 75.0, np.array([25.0, 7.5, 1.5]))
+    SelectUgvFrontier("select", ctx).tick_once()
+    node = FollowFrontierGoal("follow", ctx)
+    assert run(node, ctx, robot, ticks=25) == Status.RUNNING  # 10 m away from it, then back towards it
+    assert max(p[0] for p in robot.trail) >= 44.5 and robot.position[0] < 35.0
+    assert not events(ctx, "csiro_goal_failed")
+
+
+def test_time_away_while_interrupted_is_no_lack_of_progress(tunnel):
+    robot, ctx, st, node = selected(tunnel)
+    robot.jam(10.0)
+    assert run(node, ctx, robot, ticks=10) == Status.RUNNING   # stuck 10 s: within the 15 s window
+    node.stop(Status.INVALID)                                  # explore-sync takes over ...
+    ctx.clock.now_s += 120.0                                   # ... and gives the robot back later
+    SelectUgvFrontier("select", ctx).tick_once()
+    assert run(node, ctx, robot, ticks=3) == Status.RUNNING and not events(ctx, "csiro_goal_failed")
+
+
 def test_explored_frontier_ends_the_goal(tunnel):
     robot, ctx, st, node = selected(tunnel)
     assert run(node, ctx, robot, ticks=5) == Status.RUNNING
@@ -62,6 +89,23 @@ def test_uav_completes_a_frontier_within_the_blacklist_radius(tunnel, tunnel_poi
     node = FollowFrontierGoal("follow", ctx, tolerance_m=0.5)
     assert run(node, ctx, robot, ticks=40) == Status.SUCCESS
     assert events(ctx, "csiro_goal_done")[0]["why"] == "complete" and key[1] in st.blacklist
+
+
+def test_a_uav_flies_on_to_a_place_within_eta_blacklist_of_the_centre_rather_than_stop_short(
+        tunnel, tunnel_points):
+    grid, a, _ = tunnel
+    robot, ctx, st = uav_with_frontiers(grid, a, tunnel_points)          # at x = a + 18, mid-drift
+    centre = a + [28.0, 4.0, 1.5]                               # in the rock 2 m beyond the wall, ahead
+    place = reachable_near(ctx, robot, centre)[1]
+    assert 2.0 < np.linalg.norm(place - centre) < 3.0           # 1 m short of that place is out of 3 m
+    at_wall = a + [28.0, 1.6, 1.5]                              # the part of it in sight, at the wall
+    st.frontiers._frontiers = {99: Frontier(id=99, points=np.array([centre, at_wall]),
+                                            normals=np.array([[0.0, 1.0, 0.0]] * 2), areas=np.array([20.0, 5.0]),
+                                            mean=centre, cov=np.diag([4.0, 0.01, 4.0]))}
+    SelectUavFrontier("select", ctx).tick_once()
+    assert bb("csiro_goal") == ["r1", 99] and np.allclose(bb("goal"), place)
+    assert run(FollowFrontierGoal("follow", ctx, tolerance_m=1.0), ctx, robot, ticks=40) == Status.SUCCESS
+    assert events(ctx, "csiro_goal_done")[0]["why"] == "complete" and not events(ctx, "csiro_goal_failed")
 
 
 def test_a_completed_uav_frontier_stays_blacklisted_until_it_is_updated(tunnel, tunnel_points):

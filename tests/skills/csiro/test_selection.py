@@ -98,18 +98,28 @@ def test_uav_flies_for_its_own_frontier_and_skips_blacklisted_ones(tunnel, tunne
     assert node.status == Status.SUCCESS and bb("csiro_goal") != first
 
 
-def test_uav_blacklists_a_frontier_wholly_in_its_blind_cones_behind_mapped_rock(tunnel, tunnel_points):
+def select_beside_a_big_frontier(tunnel, tunnel_points, point, normal, cov_diag):
+    """One selection of a flying robot that holds, besides its frontiers, a one-point frontier
+    (id 99) at ``point``, the largest and nearest (eq. 16 would take it); the node, context,
+    CSIRO state and that frontier, after checking it was blacklisted behind a surface."""
     grid, a, _ = tunnel
     robot, ctx, st = uav_with_frontiers(grid, a, tunnel_points)
-    beyond = a + np.array([18.0, 0.0, 5.0])                  # straight up (blind), through the roof
-    assert grid.value_at(a[None] + [[18.0, 0.0, 3.1]])[0] == OCCUPIED
-    big = Frontier(id=99, points=beyond[None], normals=np.array([[0.0, 0.0, 1.0]]), areas=np.array([25.0]),
-                   mean=beyond, cov=np.diag([4.0, 4.0, 0.01]))
-    st.frontiers._frontiers[99] = big                          # the largest, nearest: eq. 16 would take it
+    big = Frontier(id=99, points=point[None], normals=np.array([normal]), areas=np.array([25.0]),
+                   mean=point, cov=np.diag(cov_diag))
+    st.frontiers._frontiers[99] = big
     node = SelectUavFrontier("select", ctx)
     node.tick_once()
     assert node.status == Status.SUCCESS and bb("csiro_goal")[1] != 99 and 99 in st.blacklist
     assert events(ctx, "csiro_frontier_behind_surface")[0]["id"] == 99
+    return node, ctx, st, big
+
+
+def test_uav_blacklists_a_frontier_wholly_in_its_blind_cones_behind_mapped_rock(tunnel, tunnel_points):
+    grid, a, _ = tunnel
+    beyond = a + np.array([18.0, 0.0, 5.0])                  # straight up (blind), through the roof
+    assert grid.value_at(a[None] + [[18.0, 0.0, 3.1]])[0] == OCCUPIED
+    node, ctx, st, big = select_beside_a_big_frontier(tunnel, tunnel_points, beyond, [0.0, 0.0, 1.0],
+                                                      [4.0, 4.0, 0.01])
     inside = a + np.array([18.0, 1.0, 2.5])                   # one of its triangles in the drift: in view
     st.blacklist.clear()
     st.momentum = None                                         # no pull towards the frontier taken instead
@@ -117,6 +127,13 @@ def test_uav_blacklists_a_frontier_wholly_in_its_blind_cones_behind_mapped_rock(
                                           normals=np.array([[0, 1.0, 0]] * 2), areas=np.array([20.0, 5.0]))
     node.tick_once()
     assert bb("csiro_goal")[1] == 99 and 99 not in st.blacklist
+
+
+def test_uav_blacklists_a_frontier_level_with_it_wholly_behind_a_mapped_wall(tunnel, tunnel_points):
+    grid, a, _ = tunnel
+    behind = a + np.array([19.0, 3.5, 1.5])                    # 1.5 m beyond the wall at y + 2, level with it
+    assert grid.value_at(a[None] + [[19.0, 2.1, 1.5]])[0] == OCCUPIED
+    select_beside_a_big_frontier(tunnel, tunnel_points, behind, [0.0, 1.0, 0.0], [4.0, 0.01, 4.0])
 
 
 def test_uav_skips_a_frontier_whose_centre_no_reachable_place_comes_within_eta_blacklist_of(tunnel, tunnel_points):
@@ -132,8 +149,10 @@ def test_uav_skips_a_frontier_whose_centre_no_reachable_place_comes_within_eta_b
     assert 99 not in st.blacklist                              # skipped, not blacklisted: the map may open
     assert events(ctx, "csiro_frontier_out_of_reach")[0]["id"] == 99
     within = a + np.array([19.0, 3.5, 1.5])                    # 1.5 m beyond the wall: a place within 3 m
+    at_wall = a + np.array([19.0, 1.6, 1.5])                   # and part of it in sight, at the wall
     st.momentum = None
-    st.frontiers._frontiers[99] = replace(big, points=within[None], mean=within)
+    st.frontiers._frontiers[99] = replace(big, points=np.array([within, at_wall]), normals=np.array([[0, 1.0, 0]] * 2),
+                                          areas=np.array([20.0, 5.0]), mean=within)
     node.tick_once()
     assert bb("csiro_goal")[1] == 99
 
