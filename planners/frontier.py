@@ -6,8 +6,6 @@ sensor observes it (issue 16 item 7: a LiDAR with a narrow vertical view sees th
 unseen air under a drift's roof only from afar), and the cluster whose goal is nearest
 along the navigation graph is chosen. Clusters whose goal failed (unreachable, or
 still a frontier after a visit) are blacklisted by the caller.
-:func:`observable_frontiers` (which map.png draws) also checks each voxel's line of
-sight from every reachable viewpoint, which is too slow for every planning step.
 """
 
 from __future__ import annotations
@@ -83,15 +81,9 @@ def _unknown_faces(flat_occ: np.ndarray, voxels: Voxels, depth: int) -> np.ndarr
     return out
 
 
-#: Viewpoints tried per frontier voxel for a line of sight, spread from the nearest
-#: to the farthest of those whose elevation the sensor covers (bounds the work).
-SIGHT_TRIES = 6
 #: Viewpoints that may observe a frontier, and goal candidates, are one node per cell
-#: of this size (m) ...
+#: of this size (m).
 VIEWPOINT_SPACING_M = 1.2
-#: ... and a voxel's nearest this many of them (bounds the memory: they cover 12 m
-#: of a 4 m wide drift either way, or a ball of about 4 m in open 3-D space).
-VIEWPOINTS_PER_VOXEL = 128
 #: A goal node, and a viewpoint that counts, is at most this far from its frontier (m).
 MAX_GOAL_OFFSET_M = 12.0
 
@@ -203,48 +195,6 @@ def clear_sight(grid: Grid, a: np.ndarray, b: np.ndarray) -> np.ndarray:
     flat = np.where(inside, (i * ny + j) * nz + k, 0)
     rock = ~inside | (grid.occupancy.reshape(-1)[flat] == OCCUPIED)
     return np.bincount(seg[rock], minlength=len(a)) == 0
-
-
-def observable_frontiers(grid: Grid, voxels: np.ndarray, viewpoints: np.ndarray, *, view_up_deg: float,
-                         reach_m: float, tries: int = SIGHT_TRIES) -> np.ndarray:
-    """The frontier ``voxels`` (flat indices) that the sensor can observe from one of
-    the ``viewpoints`` (sensor positions the robot can reach), within ``reach_m``.
-
-    A frontier is the boundary of what the robot's sensor has seen, so it is a frontier
-    for that sensor only while some place the robot can stand would show it (CSIRO's
-    frontiers come from the sensor's own views and carry an observer position; here
-    the observer must exist). A LiDAR with a narrow vertical field of view, 30° on the
-    legged robot, sees a point ``dz`` above it only from at least ``dz / tan 15°``
-    away: the top of a 3 m drift from 8 m along it. Where no reachable viewpoint that
-    far has a clear line (the top of a dead end, of a short cross-cut, behind a bend),
-    the unknown air or rock above those voxels stays unknown however often the robot
-    visits them, and calling them frontiers sends it to look again and again and
-    leaves them on the map. A voxel is observable when, from at least one viewpoint,
-    it lies within ``view_up_deg`` above the sensor (with half a voxel of slack) and
-    the line to it crosses no known rock (:func:`clear_sight`); of its
-    :data:`VIEWPOINTS_PER_VOXEL` nearest viewpoints, up to ``tries`` are tried,
-    spread from the nearest to the farthest.
-    """
-    if len(voxels) == 0 or len(viewpoints) == 0:
-        return voxels[:0]
-    pts = grid.to_world(np.stack(np.unravel_index(voxels, grid.shape), axis=1))
-    k = min(VIEWPOINTS_PER_VOXEL, len(viewpoints))
-    dist, vp = cKDTree(viewpoints).query(pts, k=k, distance_upper_bound=reach_m)
-    dist, vp = dist.reshape(len(pts), k), vp.reshape(len(pts), k)   # nearest first
-    ok = np.isfinite(dist)
-    ok[ok] = in_view(viewpoints[vp[ok]], np.broadcast_to(pts[:, None], (len(pts), k, 3))[ok], view_up_deg,
-                     0.5 * grid.voxel_size_m)
-    count = ok.sum(axis=1)
-    rank = np.argsort(~ok, axis=1, kind="stable")   # each voxel's usable viewpoints first, nearest first
-    seen = np.zeros(len(voxels), dtype=bool)
-    for t in range(tries):
-        todo = np.flatnonzero(~seen & (count > t))
-        if len(todo) == 0:
-            break
-        # the t-th of ``tries`` picks, spread over each voxel's usable viewpoints by distance
-        pick = rank[todo, (t * count[todo]) // np.minimum(count[todo], tries)]
-        seen[todo] = clear_sight(grid, viewpoints[vp[todo, pick]], pts[todo])
-    return voxels[seen]
 
 
 def frontier_clusters(grid: Grid, voxels: np.ndarray, *, cluster_radius_m: float, min_cluster_voxels: int,
