@@ -148,6 +148,11 @@ class SequentialFrontiers:
         """The kept viewpoints H, oldest first."""
         return tuple(self._viewpoints)
 
+    @property
+    def last_viewpoint(self) -> np.ndarray | None:
+        """Where the last update was seen from (None before the first)."""
+        return None if self._last is None else self._last[1].copy()
+
     def due(self, t_s: float, position: np.ndarray) -> bool:
         """Whether an update is due: never updated yet, or moved at least d_min since the last
         update and at least T_min later."""

@@ -52,8 +52,11 @@ class FollowFrontierGoal(GoTo):
     observer moved more than ``reselect_m`` from the goal, it changed while the robot stood at
     the goal (select again), a teammate's frontier's observer was reached (only its owner can
     update it; the place joins the robot's trajectory points, which discount it, equation 14),
-    or (flying robot) it came within eta_blacklist of its centre (complete, and blacklisted; a
-    goal within that radius of the centre is flown to until then, not ``tolerance_m`` short);
+    or (flying robot) it came within eta_blacklist of its centre and the frontiers were updated
+    from within that radius (``look_due`` asks for that update: the paper's rule alone ends the
+    goal before a sweep from there, at 1 Hz, could show what lies beyond) and it is still there
+    (complete, and blacklisted; a goal within that radius of the centre is flown to until then,
+    not ``tolerance_m`` short);
     RUNNING on the way and while standing at the goal; FAILURE when the goal failed
     (``csiro_goal_failed`` in the log).
     """
@@ -96,6 +99,10 @@ class FollowFrontierGoal(GoTo):
         done = self._frontier_done(st)
         if done:
             return self._done(done)
+        if self._awaiting_look(st):
+            st.look_due = True
+            self.feedback_message = "within eta_blacklist of the frontier's centre, waiting for a sweep from here"
+            return Status.RUNNING
         to_go = self._to_go()
         if to_go is not None and self.watch.update(self.ctx.clock.now_s, r.position, to_go):
             return self._failed(st, f"closest approach improved less than {self.watch.progress_m:g} m in "
@@ -197,16 +204,24 @@ class FollowFrontierGoal(GoTo):
             frontier = self._own_frontier()
             if frontier is None:
                 return "explored"
-            if uav_frontier_complete(frontier, r.position, st.selection):
-                st.blacklist.add(frontier)
-                return "complete"
-            return ""
+            seen_from = st.frontiers.last_viewpoint
+            if (not uav_frontier_complete(frontier, r.position, st.selection) or seen_from is None
+                    or not uav_frontier_complete(frontier, seen_from, st.selection)):
+                return ""
+            st.blacklist.add(frontier)
+            return "complete"
         summary = st.summaries.get(key)
         if summary is None:
             return "explored"
         if self.goal is not None and np.linalg.norm(summary.observer[:2] - self.goal[:2]) > self.p["reselect_m"]:
             return "observer moved"
         return ""
+
+    def _awaiting_look(self, st: CsiroState) -> bool:
+        """A flying robot within eta_blacklist of its frontier's centre (which ``_frontier_done``
+        did not find complete: no update of its frontiers from within that radius yet)."""
+        frontier = self._own_frontier() if self.robot.mobility.aerial else None
+        return frontier is not None and uav_frontier_complete(frontier, self.robot.position, st.selection)
 
     def _failed(self, st: CsiroState, why: str) -> Status:
         self.stop_own_motion()

@@ -73,6 +73,8 @@ def test_kept_viewpoints_are_d_vp_apart_and_updates_need_d_min_and_t_min():
     assert not seq.due(10.2, np.array([12.0, 0, 1]))                  # too soon
     assert not seq.due(11.0, np.array([10.5, 0, 1]))                  # too close
     assert seq.due(10.5, np.array([11.0, 0, 1]))
+    assert np.allclose(seq.last_viewpoint, [10.0, 0.0, 1.0])              # where the last update saw from
+    assert SequentialFrontiers().last_viewpoint is None
 
 
 def test_a_degenerate_cloud_is_no_error_and_gives_no_frontier():

@@ -8,14 +8,33 @@ import numpy as np
 import py_trees
 from delve.planners.csiro.frontier_types import Frontier
 from delve.planners.occupancy import FREE, OCCUPIED, UNKNOWN
-from delve.skills.csiro import FollowFrontierGoal, SelectUavFrontier, SelectUgvFrontier
+from delve.skills.csiro import FollowFrontierGoal, SelectUavFrontier, SelectUgvFrontier, UpdateFrontiers, csiro_state
 from delve.skills.csiro.follow import reachable_near
 from delve.skills.navigation import navigator
 from py_trees.common import Status
 
 from ..fakes import bb, events, run
-from .conftest import uav_with_frontiers
+from .conftest import sweep, uav_with_frontiers
 from .test_selection import ground_robot, summary
+
+
+def fly(node, ctx, robot, points=None, ticks: int = 40) -> Status:
+    """``run`` with the look ``node`` asks for (``look_due``) taken on the next tick: a sweep of
+    ``points`` from where the robot is through ``UpdateFrontiers``, or with ``points`` None a
+    frontier update that sees nothing new (the frontiers stay as they are)."""
+    update, st = UpdateFrontiers("update", ctx), csiro_state(ctx)
+    for _ in range(ticks):
+        if st.look_due and points is None:
+            st.frontiers.update(ctx.clock.now_s, robot.position, np.zeros((0, 3)))
+            st.look_due = False
+        elif st.look_due:
+            sweep(robot, points)
+            update.tick_once()
+        node.tick_once()
+        if node.status != Status.RUNNING:
+            return node.status
+        robot.step(1.0)
+    return node.status
 
 
 def selected(tunnel, frontiers_at=(40.0,)):
@@ -87,8 +106,32 @@ def test_uav_completes_a_frontier_within_the_blacklist_radius(tunnel, tunnel_poi
     SelectUavFrontier("select", ctx).tick_once()
     key = py_trees.blackboard.Blackboard.storage["/r1/csiro_goal"]
     node = FollowFrontierGoal("follow", ctx, tolerance_m=0.5)
-    assert run(node, ctx, robot, ticks=40) == Status.SUCCESS
+    assert fly(node, ctx, robot) == Status.SUCCESS
     assert events(ctx, "csiro_goal_done")[0]["why"] == "complete" and key[1] in st.blacklist
+
+
+def test_a_uav_within_eta_blacklist_of_its_frontier_completes_it_only_after_a_look_from_there(
+        tunnel, tunnel_points):
+    grid, a, _ = tunnel
+    robot, ctx, st = uav_with_frontiers(grid, a, tunnel_points)
+    SelectUavFrontier("select", ctx).tick_once()
+    key = bb("csiro_goal")
+    node = FollowFrontierGoal("follow", ctx, tolerance_m=0.5)
+    assert run(node, ctx, robot, ticks=40) == Status.RUNNING              # no sweep: it waits
+    centre = next(f for f in st.frontiers.frontiers if f.id == key[1]).mean
+    assert np.linalg.norm(robot.position - centre) <= 3.0 and st.look_due
+    assert node.feedback_message.startswith("within eta_blacklist") and not events(ctx, "csiro_goal_done")
+    assert fly(node, ctx, robot, ticks=2) == Status.SUCCESS                 # the look leaves it as it was
+    assert events(ctx, "csiro_goal_done")[0]["why"] == "complete" and key[1] in st.blacklist
+
+
+def test_a_frontier_that_a_look_from_within_eta_blacklist_moves_on_is_not_complete(tunnel, tunnel_points):
+    grid, a, _ = tunnel
+    robot, ctx, st = uav_with_frontiers(grid, a, tunnel_points)
+    SelectUavFrontier("select", ctx).tick_once()
+    key = bb("csiro_goal")
+    assert fly(FollowFrontierGoal("follow", ctx, tolerance_m=0.5), ctx, robot, tunnel_points) == Status.SUCCESS
+    assert events(ctx, "csiro_goal_done")[0]["why"] == "changed" and key[1] not in st.blacklist
 
 
 def test_a_uav_flies_on_to_a_place_within_eta_blacklist_of_the_centre_rather_than_stop_short(
@@ -104,7 +147,7 @@ def test_a_uav_flies_on_to_a_place_within_eta_blacklist_of_the_centre_rather_tha
                                             mean=centre, cov=np.diag([4.0, 0.01, 4.0]))}
     SelectUavFrontier("select", ctx).tick_once()
     assert bb("csiro_goal") == ["r1", 99] and np.allclose(bb("goal"), place)
-    assert run(FollowFrontierGoal("follow", ctx, tolerance_m=1.0), ctx, robot, ticks=40) == Status.SUCCESS
+    assert fly(FollowFrontierGoal("follow", ctx, tolerance_m=1.0), ctx, robot) == Status.SUCCESS
     assert events(ctx, "csiro_goal_done")[0]["why"] == "complete" and not events(ctx, "csiro_goal_failed")
 
 
@@ -114,7 +157,7 @@ def test_a_completed_uav_frontier_stays_blacklisted_until_it_is_updated(tunnel, 
     select = SelectUavFrontier("select", ctx)
     select.tick_once()
     key = py_trees.blackboard.Blackboard.storage["/r1/csiro_goal"]
-    assert run(FollowFrontierGoal("follow", ctx, tolerance_m=0.5), ctx, robot, ticks=40) == Status.SUCCESS
+    assert fly(FollowFrontierGoal("follow", ctx, tolerance_m=0.5), ctx, robot) == Status.SUCCESS
     assert events(ctx, "csiro_goal_done")[0]["why"] == "complete"
     f = next(f for f in st.frontiers.frontiers if f.id == key[1])
     st.frontiers.discard([g.id for g in st.frontiers.frontiers if g.id != key[1]])   # only this one is left
@@ -204,7 +247,7 @@ def test_a_uav_short_of_its_frontier_on_a_stale_graph_goes_on_to_the_place_the_r
     first = np.array(py_trees.blackboard.Blackboard.storage["/r1/goal"])
     assert first[0] > a[0] + 13.0                               # the stale graph's nearest place
     node = FollowFrontierGoal("follow", ctx, tolerance_m=0.5)
-    assert run(node, ctx, robot, ticks=40) == Status.SUCCESS
+    assert fly(node, ctx, robot) == Status.SUCCESS
     assert events(ctx, "csiro_goal_done")[0]["why"] == "complete" and not events(ctx, "csiro_goal_failed")
     assert len(events(ctx, "goto")) >= 2 and events(ctx, "goto")[-1]["goal"][0] < first[0] - 1.0
 
