@@ -5,7 +5,7 @@ momentum reward (equation 16).
 from __future__ import annotations
 
 from collections import deque
-from collections.abc import Collection, Sequence
+from collections.abc import Collection, Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -180,10 +180,15 @@ class UavBlacklist:
 
 
 def uav_rewards(frontiers: Sequence[Frontier], agent_position: np.ndarray, momentum: UavMomentum | None,
-                params: CsiroSelectionParams) -> np.ndarray:
+                params: CsiroSelectionParams, path_m: Mapping[int, float] | None = None) -> np.ndarray:
     """(F,) equation 16: p_f * size_f^2 / max{eta_blacklist, d_w(o_f, a)} with o_f the frontier's
     mean and momentum p_f = s_f * w^(v . v'): s_f for the frontier selected last, v the unit
-    vector to the frontier, v' that of ``momentum`` (p_f = 1 without one)."""
+    vector to the frontier, v' that of ``momentum`` (p_f = 1 without one).
+
+    Not in the paper: ``path_m`` (by frontier id) is the length of the way there; where it is
+    longer than d_w it is the distance (a frontier 20 m away through rock and 200 m round by
+    the tunnels is not near)."""
+    path_m = path_m or {}
     agent = np.asarray(agent_position, float)
     out = np.zeros(len(frontiers))
     for i, f in enumerate(frontiers):
@@ -194,23 +199,25 @@ def uav_rewards(frontiers: Sequence[Frontier], agent_position: np.ndarray, momen
             v = v / max(float(np.linalg.norm(v)), np.finfo(float).tiny)
             same = params.uav_same_frontier_gain if f.id == momentum.frontier_id else 1.0
             momentum_gain = same * params.uav_momentum_weight ** float(v @ momentum.direction)
-        distance = max(params.uav_blacklist_m, float(weighted_distance(agent, centre, params.uav_z_weight)))
+        distance = max(params.uav_blacklist_m, float(weighted_distance(agent, centre, params.uav_z_weight)),
+                       path_m.get(f.id, 0.0))
         out[i] = momentum_gain * uav_frontier_size_m(f, params) ** 2 / distance
     return out
 
 
 def rank_uav_frontiers(frontiers: Sequence[Frontier], agent_position: np.ndarray, momentum: UavMomentum | None,
-                       params: CsiroSelectionParams, *, blacklist: Collection[int] = ()
-                       ) -> list[tuple[Frontier, UavMomentum]]:
+                       params: CsiroSelectionParams, *, blacklist: Collection[int] = (),
+                       path_m: Mapping[int, float] | None = None) -> list[tuple[Frontier, UavMomentum]]:
     """Every frontier of at least ``uav_min_area_m2``, not in ``blacklist`` and not already
-    complete, by decreasing equation-16 reward (equal rewards: the smaller id first), each with
+    complete, by decreasing equation-16 reward (with the ways there ``path_m``, see
+    :func:`uav_rewards`; equal rewards: the smaller id first), each with
     the momentum to pass next time if it is selected (the direction kept while the same frontier
     stays selected)."""
     agent = np.asarray(agent_position, float)
     banned = set(blacklist)
     ok = [f for f in frontiers if f.area >= params.uav_min_area_m2 and f.id not in banned
           and not uav_frontier_complete(f, agent, params)]
-    rewards = uav_rewards(ok, agent, momentum, params)
+    rewards = uav_rewards(ok, agent, momentum, params, path_m)
     ranked = [ok[j] for j in sorted(range(len(ok)), key=lambda j: (-rewards[j], ok[j].id))]
     return [(f, _momentum_for(f, agent, momentum)) for f in ranked]
 

@@ -7,6 +7,7 @@ from typing import Any
 import numpy as np
 from py_trees.common import Status
 from py_trees.ports import PortInformation
+from scipy.spatial import cKDTree
 
 from ...planners.csiro.selection import GoalProgress, uav_frontier_complete
 from ...planners.csiro.topometric import frontier_node
@@ -24,13 +25,28 @@ def reachable_near(ctx: Any, robot: Any, point: np.ndarray,
     ``fresh`` the graph is rebuilt first if the map changed since it was built."""
     nav = navigator(ctx, robot)
     plan = nav.from_robot(force=fresh and nav.map_changed())
-    if plan is None:
-        return None
-    reach = np.flatnonzero(np.isfinite(plan.distances))
+    reach = _reachable(plan)
     if not len(reach):
         return None
     node = int(reach[np.argmin(np.linalg.norm(plan.graph.positions[reach] - point, axis=1))])
     return plan.path_to(node), plan.graph.positions[node].copy()
+
+
+def way_lengths(ctx: Any, robot: Any, points: np.ndarray) -> np.ndarray | None:
+    """(K,) the length of the way to each of ``points`` (K, 3): along the robot's navigation graph
+    to the node it can reach that lies nearest the point, then straight on; None when the robot
+    is off its graph."""
+    plan = navigator(ctx, robot).from_robot()
+    reach = _reachable(plan)
+    if not len(reach):
+        return None
+    gap, k = cKDTree(plan.graph.positions[reach]).query(np.reshape(points, (-1, 3)))
+    return plan.distances[reach[k]] + gap
+
+
+def _reachable(plan: Any) -> np.ndarray:
+    """The nodes a plan's shortest-path tree reaches (none without a plan)."""
+    return np.zeros(0, dtype=int) if plan is None else np.flatnonzero(np.isfinite(plan.distances))
 
 
 class FollowFrontierGoal(GoTo):

@@ -17,7 +17,7 @@ from ...planners.occupancy import Grid
 from ...planners.visibility import line_of_sight
 from ..base import Param, Skill
 from ..navigation import navigator
-from .follow import reachable_near
+from .follow import reachable_near, way_lengths
 from .frontiers import body_lift
 from .state import csiro_state
 
@@ -103,8 +103,11 @@ class SelectUavFrontier(_Select):
     def update(self) -> Status:
         r, name = self.robot, self.ctx.name
         st = csiro_state(self.ctx, r.view_up_deg)
-        ranked = rank_uav_frontiers(st.frontiers.frontiers, r.position, st.momentum, st.selection,
-                                    blacklist=st.blacklist.ids(st.frontiers.frontiers))
+        frontiers = st.frontiers.frontiers
+        ways = way_lengths(self.ctx, r, np.array([f.mean for f in frontiers])) if frontiers else None
+        ranked = rank_uav_frontiers(frontiers, r.position, st.momentum, st.selection,
+                                    blacklist=st.blacklist.ids(frontiers),
+                                    path_m=None if ways is None else dict(zip((f.id for f in frontiers), ways)))
         for frontier, momentum in ranked:   # by eq. 16; skipped: out of reach, blacklisted: behind rock
             near, unreachable = self._nearest_place(frontier)
             if unreachable:

@@ -183,6 +183,16 @@ def test_uav_distance_is_at_least_the_blacklist_radius():
     assert r[0] == pytest.approx(4.0 / 3.0) and r[1] == pytest.approx(4.0 / 3.5)
 
 
+def test_uav_distance_is_the_way_there_where_it_is_longer_than_the_line():
+    near, far = frontier(1, [10.0, 0.0, 0.0]), frontier(2, [-20.0, 0.0, 0.0])
+    assert select_uav_frontier([near, far], np.zeros(3), None, P)[0].id == 1
+    ways = {1: 100.0, 2: 20.0}                                # 10 m through rock, 100 m round by the tunnels
+    r = uav_rewards([near, far], np.zeros(3), None, P, path_m=ways)
+    assert r[0] == pytest.approx(4.0 / 100.0) and r[1] == pytest.approx(4.0 / 20.0)
+    assert [f.id for f, _ in rank_uav_frontiers([near, far], np.zeros(3), None, P, path_m=ways)] == [2, 1]
+    assert uav_rewards([near], np.zeros(3), None, P, path_m={1: 5.0})[0] == pytest.approx(4.0 / 10.0)  # never shorter
+
+
 def test_uav_momentum_keeps_the_current_frontier_and_direction():
     ahead = frontier(1, [20.0, 0.0, 0.0])
     behind = frontier(2, [-10.0, 0.0, 0.0])

@@ -42,3 +42,12 @@ def uav_with_frontiers(grid, a, tunnel_points):
     sweep(robot, tunnel_points)
     UpdateFrontiers("update", ctx).tick_once()
     return robot, ctx, csiro_state(ctx)
+
+
+@pytest.fixture(scope="session")
+def two_drifts():
+    """Two parallel drifts along x, 3 m wide, 3 m high, floor z = 1 m, at y = 4 and y = 12 (5 m of
+    rock between them), joined at x = 45 only; mapped throughout."""
+    return syn.carve((50.0, 16.0, 6.0), 0.2, [syn.Tunnel((3.0, 4.0, 1.0), (45.0, 4.0, 1.0), 3.0, 3.0),
+                                              syn.Tunnel((3.0, 12.0, 1.0), (45.0, 12.0, 1.0), 3.0, 3.0),
+                                              syn.Tunnel((45.0, 4.0, 1.0), (45.0, 12.0, 1.0), 3.0, 3.0)])

@@ -9,11 +9,11 @@ import py_trees
 from delve.planners.csiro.frontier_types import Frontier
 from delve.planners.occupancy import FREE, OCCUPIED, UNKNOWN
 from delve.skills.csiro import FollowFrontierGoal, SelectUavFrontier, SelectUgvFrontier, UpdateFrontiers, csiro_state
-from delve.skills.csiro.follow import reachable_near
+from delve.skills.csiro.follow import reachable_near, way_lengths
 from delve.skills.navigation import navigator
 from py_trees.common import Status
 
-from ..fakes import bb, events, run
+from ..fakes import FakeRobot, bb, events, make_ctx, run
 from .conftest import sweep, uav_with_frontiers
 from .test_selection import ground_robot, summary
 
@@ -34,6 +34,7 @@ def fly(node, ctx, robot, points=None, ticks: int = 40) -> Status:
         if node.status != Status.RUNNING:
             return node.status
         robot.step(1.0)
+        ctx.clock.now_s += 1.0
     return node.status
 
 
@@ -130,8 +131,15 @@ def test_a_frontier_that_a_look_from_within_eta_blacklist_moves_on_is_not_comple
     robot, ctx, st = uav_with_frontiers(grid, a, tunnel_points)
     SelectUavFrontier("select", ctx).tick_once()
     key = bb("csiro_goal")
-    assert fly(FollowFrontierGoal("follow", ctx, tolerance_m=0.5), ctx, robot, tunnel_points) == Status.SUCCESS
-    assert events(ctx, "csiro_goal_done")[0]["why"] == "changed" and key[1] not in st.blacklist
+    node = FollowFrontierGoal("follow", ctx, tolerance_m=0.5)
+    for _ in range(20):                                         # on until the tick that takes a look
+        looking = st.look_due
+        assert fly(node, ctx, robot, tunnel_points, ticks=1) == Status.RUNNING
+        if looking:
+            break
+    ahead = next(f for f in st.frontiers.frontiers if f.id == key[1])
+    assert looking and np.linalg.norm(ahead.mean - robot.position) > 3.0      # it moved on down the tunnel
+    assert key[1] not in st.blacklist and not events(ctx, "csiro_goal_done")
 
 
 def test_a_uav_flies_on_to_a_place_within_eta_blacklist_of_the_centre_rather_than_stop_short(
@@ -268,3 +276,11 @@ def test_reaching_the_goal_asks_for_a_look_from_there(tunnel):
         if node.feedback_message.startswith("at the goal"):
             break
     assert st.look_due
+
+
+def test_the_way_to_a_point_goes_round_by_the_drifts_not_through_the_rock(two_drifts):
+    robot = FakeRobot(two_drifts, np.array([10.0, 4.0, 2.5]), platform="aerial")
+    ways = way_lengths(make_ctx(robot), robot, np.array([[30.0, 4.0, 2.5], [10.0, 12.0, 2.5], [10.0, 7.0, 2.5]]))
+    assert 20.0 <= ways[0] < 22.0                                 # along the drift
+    assert 70.0 <= ways[1] < 85.0                                 # 8 m away in line: round by x = 45
+    assert 2.5 < ways[2] < 5.0                                    # in the rock: to the wall, then straight on

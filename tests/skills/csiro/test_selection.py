@@ -182,3 +182,19 @@ def test_uav_searches_an_out_of_reach_frontier_s_version_once_on_a_rebuilt_graph
     st.momentum = None
     node.tick_once()
     assert nav.builds == builds + 1 and bb("csiro_goal")[1] != 99
+
+
+def test_uav_weighs_a_frontier_by_the_way_there_not_the_line_through_rock(two_drifts):
+    robot = FakeRobot(two_drifts, np.array([10.0, 4.0, 2.5]), platform="aerial")
+    ctx = make_ctx(robot)
+    st = csiro_state(ctx)
+
+    def patch(fid: int, centre: list[float]) -> Frontier:
+        c = np.array(centre)
+        return Frontier(id=fid, points=c[None], normals=np.array([[1.0, 0.0, 0.0]]), areas=np.array([4.0]),
+                        mean=c, cov=np.diag([1.0, 1.0, 0.01]))
+
+    st.frontiers._frontiers = {1: patch(1, [10.0, 12.0, 2.5]),     # 8 m across the rock, ~74 m round
+                               2: patch(2, [30.0, 4.0, 2.5])}      # 20 m along the drift
+    SelectUavFrontier("select", ctx).tick_once()
+    assert bb("csiro_goal") == ["r1", 2]
