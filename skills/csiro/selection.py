@@ -86,8 +86,9 @@ class SelectUgvFrontier(_Select):
 
 
 class SelectUavFrontier(_Select):
-    """Equation 16 for a flying robot, over its own frontiers: size, z-weighted distance and
-    momentum, none smaller than the size limit, blacklisted or complete. Its goal is the place
+    """Equation 16 for a flying robot, over its own frontiers: size, z-weighted distance (or the
+    way there along its navigation graph where that is longer) and momentum, none smaller than
+    the size limit, blacklisted or complete. Its goal is the place
     of the navigation graph it can reach that lies nearest the frontier's centre; a frontier whose
     centre no such place comes within eta_blacklist of (a patch in rock or beyond a wall: the UAV
     could never complete it) is skipped at this selection (``csiro_frontier_out_of_reach``, once
