@@ -221,8 +221,8 @@ class FollowFrontierGoal(GoTo):
             if frontier is None:
                 return "explored"
             seen_from = st.frontiers.last_viewpoint
-            if (not uav_frontier_complete(frontier, r.position, st.selection) or seen_from is None
-                    or not uav_frontier_complete(frontier, seen_from, st.selection)):
+            looked = seen_from is not None and uav_frontier_complete(frontier, seen_from, st.selection)
+            if not (looked and uav_frontier_complete(frontier, r.position, st.selection)):
                 return ""
             st.blacklist.add(frontier)
             return "complete"
