@@ -153,7 +153,7 @@ def tunnel_network(seed: int, *, total_length_m: float = 400.0, spacing_m: float
     half_band = (TWO_LEVEL_FLOOR_BAND_M if levels == 2
                  else max(2.0, MINE_FLOOR_BAND * spacing * tmax))
     band0 = (-half_band, half_band)
-    ramp_run = rise_up / math.tan(0.95 * plan.max_slope)     # the steepest a ramp is built
+    ramp_run = rise_up / math.tan(0.95 * plan.max_slope) + 2.0 * plan.landing  # the steepest ramp
 
     extras = loops * 1.05 * spacing
     if levels == 2:

@@ -95,12 +95,33 @@ def tunnel_roof(lateral: np.ndarray, width_m: float, height_m: float) -> np.ndar
     return (height_m - rise) + rise * np.sqrt(q)
 
 
-def carve_tunnel(canvas: VoxelCanvas, a, b, width_m: float, height_m: float) -> None:
+def landing_floor(along_m: np.ndarray, length_m: float, z_a: float, z_b: float,
+                  landing_m: float) -> np.ndarray:
+    """Floor height ``along_m`` metres from a along a passage from a to b that is flat
+    for ``landing_m`` at each end and climbs evenly in between.
+
+    The landings keep a climbing passage's floor level where the flat floors of
+    the other passages at its junctions reach into it: free space is the union
+    of the carved shapes, so without them a junction's flat floor would end in
+    a step as high as the climb over half a tunnel width.
+    """
+    climb = length_m - 2.0 * landing_m
+    if z_a == z_b:
+        return np.full(np.shape(along_m), float(z_a))
+    if climb <= 1e-9:
+        raise ValueError(f"a passage {length_m:.1f} m long cannot climb between "
+                         f"{landing_m:.1f} m landings")
+    return z_a + (z_b - z_a) * np.clip((along_m - landing_m) / climb, 0.0, 1.0)
+
+
+def carve_tunnel(canvas: VoxelCanvas, a, b, width_m: float, height_m: float,
+                 landing_m: float = 0.0) -> None:
     """Carve a straight mine tunnel between floor points a and b.
 
-    The floor follows the segment (level across it), the walls are vertical
-    and the roof an elliptic arch. The tunnel ends flush at a and b; junction
-    chambers round the ends off.
+    The floor is level across the tunnel and along it flat for ``landing_m``
+    at each end, climbing evenly in between (:func:`landing_floor`); the walls
+    are vertical and the roof an elliptic arch. The tunnel ends flush at a and
+    b; junction chambers round the ends off.
     """
     a = np.asarray(a, float)
     b = np.asarray(b, float)
@@ -115,24 +136,24 @@ def carve_tunnel(canvas: VoxelCanvas, a, b, width_m: float, height_m: float) -> 
         return
     sl, xs, ys, zs = win
     x, y = xs - a[0], ys - a[1]
-    t = (x * u[0] + y * u[1]) / length
+    along = x * u[0] + y * u[1]
     lat = x * n[0] + y * n[1]
-    ok = (t >= 0.0) & (t <= 1.0) & (np.abs(lat) <= half)
-    floor = a[2] + t * (b[2] - a[2])
+    ok = (along >= 0.0) & (along <= length) & (np.abs(lat) <= half)
+    floor = landing_floor(along, length, a[2], b[2], landing_m)
     roof = floor + tunnel_roof(lat, width_m, height_m)
     canvas.free[sl] |= ok[..., None] & (zs >= floor[..., None]) & (zs <= roof[..., None])
 
 
 def carve_chamber(canvas: VoxelCanvas, centre, radius_m: float, height_m: float,
-                  upward: list[tuple[np.ndarray, float]] = ()) -> None:
+                  upward: list[tuple[np.ndarray, float]] = (), landing_m: float = 0.0) -> None:
     """Carve a round junction chamber with a domed roof around floor point ``centre``.
 
     ``upward`` lists (horizontal unit direction, slope) of the passages that
-    climb away from the junction: the chamber floor rises with them so that
-    the junction has no step or pit.
+    climb away from the junction after a flat ``landing_m``: beyond it the
+    chamber floor rises with them so that the junction has no step or pit.
     """
     c = np.asarray(centre, float)
-    max_rise = max([s * radius_m for _, s in upward], default=0.0)
+    max_rise = max([s * max(radius_m - landing_m, 0.0) for _, s in upward], default=0.0)
     lo = c - [radius_m, radius_m, 0.0]
     hi = c + [radius_m, radius_m, max_rise + height_m]
     win = canvas.window(lo, hi)
@@ -143,7 +164,7 @@ def carve_chamber(canvas: VoxelCanvas, centre, radius_m: float, height_m: float,
     d = np.sqrt(x * x + y * y)
     rise = np.zeros(np.broadcast_shapes(x.shape, y.shape))
     for u, s in upward:
-        rise = np.maximum(rise, s * (x * u[0] + y * u[1]))
+        rise = np.maximum(rise, s * (x * u[0] + y * u[1] - landing_m))
     floor = c[2] + rise
     roof = floor + tunnel_roof(d, 2.0 * radius_m, height_m)
     ok = d <= radius_m
@@ -220,14 +241,18 @@ def slab(x: float, y: float, radius_m: float, z_lo: float, z_hi: float) -> np.nd
     return np.array([[x, y, radius_m, z_lo, z_hi]], dtype=float)
 
 
-def segment_slabs(a, b, radius_m: float, height_m: float, step_m: float = 1.0) -> np.ndarray:
-    """Clearance samples along a passage from floor point a to b (floor to roof)."""
+def segment_slabs(a, b, radius_m: float, height_m: float, step_m: float = 1.0,
+                  landing_m: float = 0.0) -> np.ndarray:
+    """Clearance samples along a passage from floor point a to b (floor to roof), its
+    floor flat for ``landing_m`` at each end (:func:`landing_floor`)."""
     a = np.asarray(a, float)
     b = np.asarray(b, float)
-    n = max(int(np.ceil(np.linalg.norm(b[:2] - a[:2]) / step_m)), 1) + 1
-    t = np.linspace(0.0, 1.0, n)[:, None]
-    p = a + t * (b - a)
-    return np.column_stack([p[:, 0], p[:, 1], np.full(n, radius_m), p[:, 2], p[:, 2] + height_m])
+    length = float(np.linalg.norm(b[:2] - a[:2]))
+    n = max(int(np.ceil(length / step_m)), 1) + 1
+    t = np.linspace(0.0, 1.0, n)
+    p = a + t[:, None] * (b - a)
+    floor = landing_floor(t * length, length, a[2], b[2], landing_m) if landing_m > 0 else p[:, 2]
+    return np.column_stack([p[:, 0], p[:, 1], np.full(n, radius_m), floor, floor + height_m])
 
 
 def slabs_conflict(s1: np.ndarray, s2: np.ndarray, clearance_m: float) -> bool:

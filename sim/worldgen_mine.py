@@ -28,6 +28,15 @@ CHAMBER_RADIUS_FACTOR = 0.6
 RAMP_SLOPE_FRACTION = 0.75
 #: Floor kept around a shaft mouth in the upper chamber, so robots can pass it.
 SHAFT_MOUTH_MARGIN_M = 2.0
+#: A climbing tunnel is flat for this fraction of the widest tunnel at each end
+#: (worldgen_geometry.landing_floor), past the flat floors of the tunnels it meets;
+#: it climbs at its slope in between. At least CHAMBER_RADIUS_FACTOR, so junction
+#: chambers stay flat.
+LANDING_FACTOR = 0.7
+#: Smallest horizontal angle between two passages leaving one junction: closer
+#: ones would run into each other (the clearance check skips passages that share
+#: a junction), e.g. a drift laid under a ramp's climb.
+MIN_BRANCH_ANGLE_DEG = 45.0
 #: Lattice steps: the four directions a tunnel may leave a junction in.
 LATTICE_DIRECTIONS = ((1, 0), (0, 1), (-1, 0), (0, -1))
 
@@ -95,10 +104,45 @@ class MinePlan:
         """A tunnel height drawn from the height range."""
         return float(self.rng.uniform(*self.height))
 
+    @property
+    def landing(self) -> float:
+        """Length of the flat floor at each end of a climbing tunnel (m)."""
+        return LANDING_FACTOR * self.width[1]
+
+    def climb_run(self, horizontal: float) -> float:
+        """Horizontal run over which a tunnel of this horizontal length climbs (between landings)."""
+        return max(horizontal - 2.0 * self.landing, 0.0)
+
+    def rise_over(self, horizontal: float, slope_tan: float) -> float:
+        """Floor rise (snapped to the voxel) of a tunnel climbing at ``slope_tan`` between its landings."""
+        return snap_toward_zero(self.climb_run(horizontal) * slope_tan, self.voxel)
+
     def slope(self, a: int, b: int) -> float:
-        """Slope (radians) of the straight floor between two nodes."""
+        """Slope (radians) of the floor between two nodes where it climbs (between the landings)."""
         pa, pb = self.nodes[a].pos, self.nodes[b].pos
-        return math.atan2(abs(pb[2] - pa[2]), float(np.hypot(*(pb[:2] - pa[:2]))))
+        dz = abs(pb[2] - pa[2])
+        if dz < 1e-9:
+            return 0.0
+        return math.atan2(dz, self.climb_run(float(np.hypot(*(pb[:2] - pa[:2])))))
+
+    def passage_slabs(self, pa: np.ndarray, pb: np.ndarray, width: float,
+                      height: float) -> np.ndarray:
+        """Clearance samples of a tunnel from floor point pa to pb (with its landings)."""
+        return segment_slabs(pa, pb, 0.5 * width, height, landing_m=self.landing)
+
+    def bearing_clear(self, n: int, xy: np.ndarray) -> bool:
+        """Whether a passage from node n towards ``xy`` leaves it at least
+        MIN_BRANCH_ANGLE_DEG away (horizontally) from every walkable passage there."""
+        p = self.nodes[n].pos[:2]
+        new = np.asarray(xy[:2], float) - p
+        for e in self.edges:
+            if n not in (e.a, e.b) or not e.walkable:
+                continue
+            old = self.nodes[e.b if e.a == n else e.a].pos[:2] - p
+            cos = float(new @ old) / max(float(np.linalg.norm(new) * np.linalg.norm(old)), 1e-12)
+            if cos > math.cos(math.radians(MIN_BRANCH_ANGLE_DEG)):
+                return False
+        return True
 
     def length(self, e: _Edge) -> float:
         """Centreline length of an edge."""
@@ -146,7 +190,7 @@ class MinePlan:
                 lo, hi = min(pa[2], pb[2]), max(pa[2], pb[2])
                 out.append((slab(pa[0], pa[1], self.shaft_radius[i], lo, hi), {e.a, e.b}))
             else:
-                out.append((segment_slabs(pa, pb, 0.5 * e.width, e.height), {e.a, e.b}))
+                out.append((self.passage_slabs(pa, pb, e.width, e.height), {e.a, e.b}))
         return out
 
     def clear(self, samples: np.ndarray, incident: set) -> bool:
@@ -159,9 +203,12 @@ class MinePlan:
         return True
 
     def edge_is_clear(self, a: int, pb: np.ndarray) -> bool:
-        """Whether a tunnel from node a to a new node at floor point pb keeps its clearance."""
+        """Whether a tunnel from node a to a new node at floor point pb keeps its clearance
+        (and leaves a away from the passages already there)."""
         pa = self.nodes[a].pos
-        samples = segment_slabs(pa, pb, 0.5 * self.width[1], self.height[1])
+        if not self.bearing_clear(a, pb):
+            return False
+        samples = self.passage_slabs(pa, pb, self.width[1], self.height[1])
         if not self.clear(samples, {a}):
             return False
         return self.clear(self.chamber_at(pb), {a})
@@ -202,7 +249,7 @@ class MinePlan:
         else:
             frac = self.rng.uniform(0.8, 1.0)
         slope = math.tan(frac * self.max_slope) if frac > 0 else 0.0
-        dz = snap_toward_zero(horizontal * min(slope, tmax), self.voxel)
+        dz = self.rise_over(horizontal, min(slope, tmax))
         signs = [s for s in (1.0, -1.0) if band[0] <= z0 + s * dz <= band[1]]
         if signs:
             return float(self.rng.choice(signs)) * dz
@@ -250,7 +297,7 @@ class MinePlan:
                 if trim and full > remaining:
                     if remaining < min_len:
                         return added
-                    pb = parent.pos + (pb - parent.pos) * (remaining / full)
+                    pb = self.shortened(parent.pos, pb, remaining / full)
                     trimmed = True
                 if not self.edge_is_clear(n, pb):
                     continue
@@ -267,6 +314,16 @@ class MinePlan:
                 if stuck > 6:
                     break
         return added
+
+    def shortened(self, pa: np.ndarray, pb: np.ndarray, fraction: float) -> np.ndarray:
+        """Floor point ``fraction`` of the way (horizontally) from pa to pb, its rise cut
+        so that the tunnel from pa climbs no steeper between its landings."""
+        horizontal = float(np.hypot(*(pb[:2] - pa[:2])))
+        run = self.climb_run(horizontal)
+        out = pa + (pb - pa) * fraction
+        tan = abs(pb[2] - pa[2]) / run if run > 0 else 0.0
+        out[2] = pa[2] + math.copysign(self.rise_over(fraction * horizontal, tan), pb[2] - pa[2])
+        return out
 
     def close_loops(self, loops: int) -> int:
         """Join lattice neighbours on the lower level that the tree left apart."""
@@ -293,8 +350,9 @@ class MinePlan:
                     break
                 n, m, _ = cands[k]
                 pa, pb = self.nodes[n].pos, self.nodes[m].pos
-                if self.clear(segment_slabs(pa, pb, 0.5 * self.width[1], self.height[1]),
-                              {n, m}):
+                if self.bearing_clear(n, pb) and self.bearing_clear(m, pa) and \
+                        self.clear(self.passage_slabs(pa, pb, self.width[1], self.height[1]),
+                                   {n, m}):
                     self.add_edge(n, m)
                     added += 1
         return added
@@ -319,7 +377,7 @@ class MinePlan:
                 if cut <= 0:
                     break
                 p_hub, p_leaf = self.nodes[hub].pos, self.nodes[leaf].pos
-                self.nodes[leaf].pos = p_hub + (p_leaf - p_hub) * ((length - cut) / length)
+                self.nodes[leaf].pos = self.shortened(p_hub, p_leaf, (length - cut) / length)
                 self.nodes[leaf].grow = False
                 excess -= cut
                 break
@@ -338,12 +396,12 @@ class MinePlan:
             e = self.edges[leaves[i]]
             pa, pb = self.nodes[e.a].pos, self.nodes[e.b].pos
             horizontal = float(np.hypot(*(pb[:2] - pa[:2])))
-            dz = snap_toward_zero(horizontal * math.tan(0.9 * self.max_slope), self.voxel)
+            dz = self.rise_over(horizontal, math.tan(0.9 * self.max_slope))
             for sign in sorted((1.0, -1.0), key=lambda s: abs(pa[2] + s * dz)):
                 old = pb.copy()
                 pb[2] = pa[2] + sign * dz
                 if self.slope(e.a, e.b) >= RAMP_SLOPE_FRACTION * self.max_slope and \
-                        self.clear(segment_slabs(pa, pb, 0.5 * e.width, e.height), {e.a, e.b}):
+                        self.clear(self.passage_slabs(pa, pb, e.width, e.height), {e.a, e.b}):
                     e.kind = "ramp"
                     return
                 pb[:] = old
@@ -424,7 +482,8 @@ def _add_level_ramp(plan: MinePlan, lower: list[int], z_up: float,
     for n in lower:
         node = plan.nodes[n]
         dz = z_up - node.pos[2]
-        kmin = max(int(round(dz / (math.tan(0.95 * plan.max_slope) * s))), 1)
+        steepest = dz / math.tan(0.95 * plan.max_slope) + 2.0 * plan.landing
+        kmin = max(int(round(steepest / s)), 1)
         taken = {tuple(np.subtract(plan.nodes[m].site, node.site)) for m in plan.neighbours(n)
                  if plan.nodes[m].site is not None}
         for d in LATTICE_DIRECTIONS:
@@ -440,15 +499,16 @@ def _add_level_ramp(plan: MinePlan, lower: list[int], z_up: float,
         node = plan.nodes[n]
         # the ramp climbs at 80-95 % of the slope limit, so its top is off the lattice
         dz = z_up - node.pos[2]
-        run = dz / math.tan(rng.uniform(0.8, 0.95) * plan.max_slope)
+        run = dz / math.tan(rng.uniform(0.8, 0.95) * plan.max_slope) + 2.0 * plan.landing
         site = (node.site[0] + k * d[0], node.site[1] + k * d[1])
         if site in plan.sites[1] or run > (k + 0.5) * s or run < (k - 0.5) * s:
             continue
         xy = node.pos[:2] + run * np.asarray(d, float)
         top = np.array([xy[0], xy[1], z_up])
         w, h = plan.draw_width(), plan.draw_height()
-        samples = segment_slabs(node.pos, top, 0.5 * w, h)
-        if plan.clear(samples, {n}) and plan.clear(plan.chamber_at(top), set()):
+        samples = plan.passage_slabs(node.pos, top, w, h)
+        if plan.bearing_clear(n, top) and plan.clear(samples, {n}) and \
+                plan.clear(plan.chamber_at(top), set()):
             root = plan.add_node(top, 1, site)
             plan.add_edge(n, root, kind="ramp", width=w, height=h)
             return root
@@ -549,13 +609,13 @@ def build_mine(plan: MinePlan, name: str) -> World:
             d = other - node.pos
             run = float(np.hypot(d[0], d[1]))
             if d[2] > 0 and run > 1e-9:
-                upward.append((d[:2] / run, d[2] / run))
+                upward.append((d[:2] / run, d[2] / plan.climb_run(run)))
         chambers.append((node.pos, r, h, upward))
 
     lo = np.full(3, np.inf)
     hi = np.full(3, -np.inf)
     for pos, r, h, upward in chambers:
-        rise = max([sl * r for _, sl in upward], default=0.0)
+        rise = max([sl * max(r - plan.landing, 0.0) for _, sl in upward], default=0.0)
         lo = np.minimum(lo, pos - [r, r, 0.0])
         hi = np.maximum(hi, pos + [r, r, h + rise])
     for e in edges:
@@ -571,14 +631,14 @@ def build_mine(plan: MinePlan, name: str) -> World:
             low, up = (pa, pb) if pa[2] <= pb[2] else (pb, pa)
             carve_shaft(canvas, low[:2], plan.shaft_radius[i], low[2], up[2])
         else:
-            carve_tunnel(canvas, pa, pb, e.width, e.height)
+            carve_tunnel(canvas, pa, pb, e.width, e.height, plan.landing)
     for pos, r, h, upward in chambers:
-        carve_chamber(canvas, pos, r, h, upward)
+        carve_chamber(canvas, pos, r, h, upward, plan.landing)
 
     graph = nx.Graph()
     for n, node in enumerate(nodes):
         graph.add_node(n, pos=node.pos.copy(), level=node.level)
     for e in edges:
         graph.add_edge(e.a, e.b, width_m=e.width, height_m=e.height, kind=e.kind,
-                       length_m=plan.length(e))
+                       length_m=plan.length(e), landing_m=0.0 if e.kind == "shaft" else plan.landing)
     return assemble_world(name, canvas, graph, nodes[0].pos)

@@ -10,6 +10,8 @@ from scipy import ndimage
 
 from delve.sim import worldgen
 from delve.sim.meshio import up_axis_rotation, write_scan_mesh
+from delve.sim.platforms import LEGGED
+from delve.sim.robot import ARRIVED, FOLLOWING, SimRobot
 
 SMALL_MINE = dict(total_length_m=120.0, spacing_m=10.0, width_m=(2.5, 3.5),
                   height_m=(2.5, 3.0), voxel_size_m=0.3)
@@ -49,8 +51,13 @@ def walk_length(world):
 
 
 def slope_deg(world, a, b):
+    """Slope of an edge's floor where it climbs (between the flat landings at its ends)."""
     pa, pb = world.centreline.nodes[a]["pos"], world.centreline.nodes[b]["pos"]
-    return math.degrees(math.atan2(abs(pb[2] - pa[2]), float(np.hypot(*(pb[:2] - pa[:2])))))
+    landing = world.centreline.edges[a, b].get("landing_m", 0.0)
+    dz = abs(pb[2] - pa[2])
+    if dz < 1e-9:
+        return 0.0
+    return math.degrees(math.atan2(dz, float(np.hypot(*(pb[:2] - pa[:2]))) - 2.0 * landing))
 
 
 def floor_components(world):
@@ -247,6 +254,38 @@ def test_single_level_shaft_to_gallery():
     assert any(g.degree(n) == 1 for n in gallery)
 
 
+def blocked_walks(world):
+    """(from, to, reason) of every walkable centreline edge a legged robot cannot walk
+    along, in either direction, with the simulator's motion model (0.1 s steps)."""
+    g = world.centreline
+    out = []
+    for a, b, d in g.edges(data=True):
+        if d["kind"] == "shaft":
+            continue
+        for s, t in ((a, b), (b, a)):
+            robot = SimRobot("walker", LEGGED, world, g.nodes[s]["pos"], radio=None)
+            robot.follow_path(g.nodes[t]["pos"][None] + [0.0, 0.0, LEGGED.body_height_m])
+            for _ in range(int(2 * d["length_m"] / (LEGGED.speed_mps * 0.1)) + 10):
+                if robot.path_status != FOLLOWING:
+                    break
+                robot.step(0.1)
+            if robot.path_status != ARRIVED:
+                out.append((s, t, robot.blocked_reason))
+    return out
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3, 4])
+@pytest.mark.parametrize("kwargs", [dict(total_length_m=300, loops=2, max_slope_deg=30),
+                                    dict(total_length_m=300, levels=2, ramp=True, loops=1,
+                                         max_slope_deg=20)], ids=["network", "two_level"])
+def test_mine_passages_are_walkable(kwargs, seed):
+    """Junction floors meet the climbing tunnels without a step (landings) and no tunnel
+    runs along another from a shared junction: every passage is walkable both ways."""
+    w = worldgen.tunnel_network(seed, **kwargs)
+    assert blocked_walks(w) == []
+
+
+
 @pytest.mark.parametrize("kwargs, message", [
     (dict(total_length_m=-5.0), "total_length_m"),
     (dict(total_length_m=float("nan")), "total_length_m"),
@@ -409,8 +448,11 @@ def test_from_mesh_start_and_errors(mine, tmp_path):
     w = worldgen.from_mesh(path, start=mine.start, name="given", voxel_size_m=0.3)
     np.testing.assert_allclose(w.start, mine.start)
     assert w.name == "given"
+    # the rock voxel furthest from any passage and from the grid's edge
+    depth = ndimage.distance_transform_edt(~np.pad(w.free, 1, constant_values=True))[1:-1, 1:-1, 1:-1]
+    rock = w.origin + (np.asarray(np.unravel_index(np.argmax(depth), depth.shape)) + 0.5) * 0.3
     with pytest.raises(ValueError, match="inside rock"):
-        worldgen.from_mesh(path, start=mine.start + [0.0, 0.0, -2.0], voxel_size_m=0.3)
+        worldgen.from_mesh(path, start=rock, voxel_size_m=0.3)
     with pytest.raises(ValueError, match="cannot read mesh"):
         worldgen.from_mesh(tmp_path / "missing.ply")
     junk = tmp_path / "junk.ply"
