@@ -33,10 +33,10 @@ def test_watchdog_recovers_a_robot_whose_feet_are_stuck():
     ends_well(mission)
 
 
-#: cerberus_wifi before the robot remembered where the link was lost: 25 back-offs
-#: (GBPlanner2 chose the same target beyond the radio edge again and again) and 66.3 %
-#: coverage when the supervisor called it home at 400 s.
-BACKOFFS_BEFORE, COVERAGE_BEFORE = 25, 0.663
+#: cerberus_wifi before the robot remembered where the link was lost (in the world its
+#: seed gave before the generator's landings, 2026-12-03): 25 back-offs, GBPlanner2
+#: choosing the same target beyond the radio edge again and again.
+BACKOFFS_BEFORE = 25
 
 
 def test_wifi_safety_backs_off_until_the_base_answers_then_resumes(tmp_path):
@@ -51,7 +51,10 @@ def test_wifi_safety_backs_off_until_the_base_answers_then_resumes(tmp_path):
     losses = events(mission, "link_loss")
     assert len(losses) == len(backoffs)
     assert sum(not e["new"] for e in losses) <= 1
-    assert report["coverage_fraction"] >= COVERAGE_BEFORE - 0.03
+    # and it goes on exploring within reach after each back-off
+    first = min(e["t"] for e in backoffs)
+    seen_then = [x.team for x in mission.state.samples if x.t <= first][-1]
+    assert report["coverage_fraction"] > seen_then + 0.05
     reconnected = [e for e in events(mission, "backtrack_done") if e["node"] == "Backtrack until connected"]
     assert reconnected and reconnected[0]["reason"] == "condition holds"
     resumed = [e for e in events(mission, "gbplanner_path") if e["t"] > reconnected[0]["t"]]

@@ -21,17 +21,19 @@ def test_out_of_reach_at_its_call_the_robot_explores_t_ce_more_then_backtracks_t
     params = mission.team.cohort
     events = robot_events(mission, "a")
     calls = [e for e in events if e["event"] == "cohort_call"]
-    # The first call in reach stores a link point; a later call finds the hub out of reach.
-    first_link = next(e for e in calls if e["reached"])
-    failed = next(e for e in calls if not e["reached"] and e["t"] > first_link["t"])
+    # A call in reach stores a link point; a later call finds the hub out of reach, and
+    # the robot goes back to where it last spoke to the hub.
+    first_reached = next(e for e in calls if e["reached"])
+    failed = next(e for e in calls if not e["reached"] and e["t"] > first_reached["t"])
+    last_link = [e for e in calls if e["reached"] and e["t"] < failed["t"]][-1]
     after = [e for e in events if e["t"] >= failed["t"]]
     assert after[1]["event"] == "cohort_extra_exploration"  # the box was not explored
     back = next(e for e in after if e["event"] == "cohort_backtrack")
     assert back["t"] == pytest.approx(failed["t"] + params.extra_explore_s, abs=0.3)
-    assert back["to"] == first_link["position"]
-    assert np.linalg.norm(np.subtract(first_link["position"][:2], mission.robots["a"].home[:2])) > 5.0
+    assert back["to"] == last_link["position"]
+    assert np.linalg.norm(np.subtract(last_link["position"][:2], mission.robots["a"].home[:2])) > 5.0
     arrived = next(e for e in after if e["event"] == "cohort_link_point")
-    assert arrived["at"] == first_link["position"] and arrived["linked"] is True
+    assert arrived["at"] == last_link["position"] and arrived["linked"] is True
     again = next(e for e in after if e["event"] == "cohort_call" and e["t"] >= arrived["t"])
     assert again["reached"] is True
 
@@ -43,11 +45,14 @@ def test_the_hub_sends_two_robots_into_different_branches_of_a_fork():
              for r in ("a", "b")}
     assert all(f["frontier"] is not None for f in first.values())
     assert np.sign(first["a"]["frontier"][1]) != np.sign(first["b"]["frontier"][1])
-    # Each robot goes deep into the branch it was sent to and never into the other one
-    # (by the end of the run, out of reach, they may be on their way back to a link).
+    # Each robot goes deep into the branch it was sent to and, once there, never into the
+    # other one (before its first call it explored on its own, in either branch; by the
+    # end of the run, out of reach, it may be on its way back to a link).
     for r in ("a", "b"):
-        y = np.asarray(mission.robots[r].traversed_path)[:, 1] * np.sign(first[r]["frontier"][1])
-        assert y.max() > 10.0 and y.min() > -3.0, r
+        y = np.array([s.positions[r][1] for s in mission.state.samples if s.t >= first[r]["t"]])
+        y *= np.sign(first[r]["frontier"][1])
+        inside = np.flatnonzero(y > 3.0)
+        assert len(inside) and y.max() > 10.0 and y[inside[0]:].min() > -3.0, r
 
 
 def test_the_robots_explore_on_while_they_call_and_only_a_frontier_stops_the_explorer():

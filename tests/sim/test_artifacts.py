@@ -71,14 +71,14 @@ def test_artifacts_in_reachable_free_space_on_their_surfaces(mine):
 
 
 def test_classes_drawn_evenly_and_spread(mine):
-    spec = PlacementSpec(min_spacing_m=8.0)
+    spec = PlacementSpec(min_spacing_m=7.0)
     arts = place_artifacts(mine, count=13, seed=5, spec=spec)
     counts = Counter(a.artifact_class for a in arts)
     assert set(counts) == set(ARTIFACT_CLASSES) and max(counts.values()) - min(counts.values()) <= 1
     assert len({a.name for a in arts}) == len(arts)
     p = _positions(arts)
     d = np.linalg.norm(p[:, None] - p[None], axis=2) + np.eye(len(p)) * 1e9
-    assert d.min() >= 8.0
+    assert d.min() >= spec.min_spacing_m
     start_d = np.linalg.norm(p - mine.start, axis=1)
     assert start_d.min() >= 8.0
 
