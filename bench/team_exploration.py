@@ -127,19 +127,38 @@ def scenario_doc(world: dict, seed: int, duration_s: float, artifacts: int,
             "base_station": {"tree": str(TREES / "base_station.yaml")}, "robots": robots_section("single")}
 
 
-def run_set(world: dict, method: str) -> dict:
-    """The overrides of one run: its world and its method's robots, base tree and team."""
+def run_set(world: dict, method: str, team_params: dict | None = None) -> dict:
+    """The overrides of one run: its world and its method's robots, base tree and team
+    (with ``team_params``, the ``--team-param`` keys given for this method)."""
     _, base, team, _ = METHODS[method]
     out = {"world": world, "robots": robots_section(method), "base_station": {"tree": str(TREES / base)}}
     if team is not None:
-        out["team"] = team
+        out["team"] = {**team, **(team_params or {})}
     return out
 
 
-def sweep_doc(worlds: dict[str, dict], methods: list[str], seeds: list[int]) -> dict:
+def sweep_doc(worlds: dict[str, dict], methods: list[str], seeds: list[int],
+              team_params: dict[str, dict] | None = None) -> dict:
     """The sweep: one runs entry per world and method (labelled ``world/method``)."""
+    team_params = team_params or {}
     return {"name": "team_exploration", "scenarios": ["scenario.yaml"], "seeds": seeds,
-            "runs": [{"label": f"{w}/{m}", "set": run_set(spec, m)} for w, spec in worlds.items() for m in methods]}
+            "runs": [{"label": f"{w}/{m}", "set": run_set(spec, m, team_params.get(m))}
+                     for w, spec in worlds.items() for m in methods]}
+
+
+def parse_team_params(items: list[str]) -> dict[str, dict]:
+    """``METHOD.KEY=VALUE`` items (VALUE in YAML) as {method: {key: value}}; ValueError if malformed."""
+    import yaml
+
+    out: dict[str, dict] = {}
+    for item in items:
+        name, sep, value = item.partition("=")
+        method, dot, key = name.partition(".")
+        if not (sep and dot and key) or method not in METHODS or METHODS[method][2] is None:
+            teams = ", ".join(m for m, spec in METHODS.items() if spec[2] is not None)
+            raise ValueError(f"--team-param {item!r}: expected METHOD.KEY=VALUE with METHOD one of {teams}")
+        out.setdefault(method, {})[key] = yaml.safe_load(value)
+    return out
 
 
 def _number(row, column: str) -> float | None:
@@ -148,12 +167,13 @@ def _number(row, column: str) -> float | None:
 
 
 def run_sweep(worlds: dict[str, dict], methods: list[str], seeds: list[int], duration_s: float, artifacts: int,
-              out: Path, jobs: int, scheduler: str | None, radio: dict | None = None) -> list[Run]:
+              out: Path, jobs: int, scheduler: str | None, radio: dict | None = None,
+              team_params: dict[str, dict] | None = None) -> list[Run]:
     """Run the sweep into ``out``; its finished rows as Runs (a failed run is printed and left out)."""
     from bench_sweep import run_bench_sweep
 
     first = scenario_doc(next(iter(worlds.values())), seeds[0], duration_s, artifacts, radio)
-    result = run_bench_sweep(out, first, sweep_doc(worlds, methods, seeds), jobs, scheduler)
+    result = run_bench_sweep(out, first, sweep_doc(worlds, methods, seeds, team_params), jobs, scheduler)
     for r in result.table[result.table["status"] != "ok"].itertuples():
         print(f"FAILED {r.run_id}: {r.error}")
     runs = []
@@ -232,12 +252,18 @@ def main(argv: list[str] | None = None) -> int:
                     help=f"the base station's radio range (default {RADIO_RANGE_M:.0f} m)")
     ap.add_argument("--radio-clear", action="store_true",
                     help="links reach the range through rock (with --radio-range-m 1000: everywhere)")
+    ap.add_argument("--team-param", action="append", default=[], metavar="METHOD.KEY=VALUE",
+                    help="a team key for one method's runs, VALUE in YAML (e.g. cohort.box_m=[60,60,20]); repeatable")
     ap.add_argument("--jobs", type=int, default=1, help="workers of the local cluster (a team run needs ~2 GB)")
     ap.add_argument("--scheduler", metavar="ADDRESS", help="run the sweep on the Dask cluster at ADDRESS")
     ap.add_argument("--out", type=Path, help="keep the sweep in DIR (and resume it there); default: a temporary folder")
     args = ap.parse_args(argv)
     if not args.radio_range_m > 0:
         ap.error(f"--radio-range-m must be > 0, got {args.radio_range_m:g}")
+    try:
+        team_params = parse_team_params(args.team_param)
+    except ValueError as err:
+        ap.error(str(err))
     seeds = args.seeds or ([1] if args.quick else [1, 2, 3, 4, 5])
     artifacts = QUICK_ARTIFACTS if args.quick else ARTIFACTS
     radio = radio_doc(args.radio_range_m, args.radio_clear)
@@ -251,17 +277,18 @@ def main(argv: list[str] | None = None) -> int:
     print(f"robots: aerial (RMF-Obelix-like), endurance {ENDURANCE_S:.0f} s, mission limit {args.duration_s:.0f} s, "
           f"radio range {args.radio_range_m:.0f} m{' (clear)' if args.radio_clear else ''}, {artifacts} artifacts; "
           f"seeds {seeds}; "
-          f"{args.scheduler or f'{args.jobs} worker(s)'}; "
+          + "".join(f"{m} team {params}; " for m, params in team_params.items())
+          + f"{args.scheduler or f'{args.jobs} worker(s)'}; "
           f"load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
     print()
     t0 = time.perf_counter()
     if args.out:
         runs = run_sweep(worlds, args.methods, seeds, args.duration_s, artifacts, args.out, args.jobs, args.scheduler,
-                         radio)
+                         radio, team_params)
     else:
         with tempfile.TemporaryDirectory(prefix="team_exploration_") as tmp:
             runs = run_sweep(worlds, args.methods, seeds, args.duration_s, artifacts, Path(tmp), args.jobs,
-                             args.scheduler, radio)
+                             args.scheduler, radio, team_params)
     print_tables(runs, list(worlds), args.methods)
     print(f"\n{len(runs)} runs in {time.perf_counter() - t0:.0f} s wall")
     return 0 if runs else 1
