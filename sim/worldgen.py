@@ -116,8 +116,11 @@ def tunnel_network(seed: int, *, total_length_m: float = 400.0, spacing_m: float
     long (within 10 %), leaving branches and dead ends; ``loops`` extra
     lattice edges then close loops. Floor heights follow a random walk
     (every edge's slope <= ``max_slope_deg``; with ``ramp`` some edges climb
-    at 75-100 % of it and are marked kind "ramp"). Junctions get round
-    chambers. ``levels=2`` adds a second level 12-15 m above part of the
+    at 75-100 % of it and are marked kind "ramp"). A climbing tunnel is level
+    for ``landing_m`` (0.7 x the widest tunnel, an edge attribute) at each end
+    and climbs at its slope in between, and no two passages leave a junction
+    less than 45 degrees apart, so a legged robot walks every passage.
+    Junctions get round chambers. ``levels=2`` adds a second level 12-15 m above part of the
     first, joined by a long ramp (``ramp=True``) and/or a vertical shaft
     (``shaft=True``); ``levels=1, shaft=True`` adds a shaft up to a small
     dead-end gallery that only a flying robot can reach. Nodes carry ``level``
