@@ -49,7 +49,9 @@ class SyncDue(Skill):
 class ReturnToComms(PathMotion):
     """Drive back into radio range: along the topometric map to where the link to the base
     station was last seen (the navigation graph of the onboard map for a flying robot, or
-    when the map has no path), then on towards home while no link comes back.
+    when the map has no path), then, re-planning on the navigation graph (a straight step
+    between topometric nodes can cut a junction's corner through rock), on towards home
+    while no link comes back.
 
     Returns SUCCESS as soon as a link to the base station exists; RUNNING on the way; FAILURE
     when home is reached without a link or the re-plans are used up.
@@ -75,7 +77,7 @@ class ReturnToComms(PathMotion):
         st = csiro_state(self.ctx, r.view_up_deg)
         target = st.contact if self.replans == 0 and st.contact is not None else r.home
         path = None
-        if not r.mobility.aerial:
+        if self.replans == 0 and not r.mobility.aerial:
             node = st.topometric.nearest_node(target)
             found = None if node is None else st.topometric.path(r.position, node)
             path = None if found is None or len(found.points) < 2 else found.points[1:]

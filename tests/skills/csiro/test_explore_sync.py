@@ -7,6 +7,8 @@ from delve.skills.csiro import CONFIG_SERVICE, CsiroConfig, ReturnToComms, Retur
     csiro_state
 from py_trees.common import Status
 
+from delve.skills.navigation import navigator
+
 from ..fakes import FakeRobot, bb, body, events, make_ctx, run
 
 
@@ -73,6 +75,22 @@ def test_back_into_range_uplink_and_back_to_the_region(tunnel):
     assert st.region is None
     due.tick_once()
     assert due.status == Status.FAILURE                               # the clock started again at the sync
+
+
+def test_a_blocked_way_back_is_planned_again_on_the_navigation_graph(tunnel):
+    """The topometric map's straight steps between trajectory nodes can cut through rock
+    (a junction's corner): a re-plan goes by the onboard map's navigation graph, towards home."""
+    robot, ctx, st, due = walked(tunnel, sync_s=20.0)
+    due.tick_once()
+    robot.radio.linked_to = LinkWithin(robot, 15.0)
+    robot.block_at = np.array([33.0, 6.0, 1.5])
+    back = ReturnToComms("back", ctx)
+    run(back, ctx, robot, ticks=12)
+    topometric, again = robot.paths[0], robot.paths[1]
+    assert np.all(np.diff(topometric[:, 0]) < -0.9)                  # 1 m steps between trajectory nodes
+    steps = np.linalg.norm(np.diff(again, axis=0), axis=1)
+    assert steps.max() < 0.5                                         # voxel to voxel on the graph
+    assert np.linalg.norm(again[-1] - robot.home) < navigator(ctx, robot).snap_radii_m[-1]
 
 
 def test_return_to_region_without_a_region_is_done_at_once(tunnel):
