@@ -54,7 +54,9 @@ class ReturnToComms(PathMotion):
     while no link comes back.
 
     Returns SUCCESS as soon as a link to the base station exists; RUNNING on the way; FAILURE
-    when home is reached without a link or the re-plans are used up.
+    when home is reached without a link or the re-plans are used up, and then the time out of
+    contact counts from now (the robot explores on and tries again after the explore-sync
+    time, instead of trying again at once).
     """
 
     PARAMS = {"max_replans": Param(int, 4, "re-plans after a blocked path or an arrival short of the link",
@@ -70,6 +72,7 @@ class ReturnToComms(PathMotion):
     def give_up(self, status: PathStatus, reason: str) -> Status:
         self.feedback_message = f"no link after {self.replans - 1} re-plans ({reason or status})"
         self.event("csiro_return_failed", reason=self.feedback_message)
+        csiro_state(self.ctx).contact_s = self.ctx.clock.now_s
         return Status.FAILURE
 
     def plan(self) -> Status:

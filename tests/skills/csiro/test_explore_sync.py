@@ -93,6 +93,21 @@ def test_a_blocked_way_back_is_planned_again_on_the_navigation_graph(tunnel):
     assert np.linalg.norm(again[-1] - robot.home) < navigator(ctx, robot).snap_radii_m[-1]
 
 
+def test_a_way_back_that_fails_is_tried_again_after_the_sync_time(tunnel):
+    robot, ctx, st, due = walked(tunnel, sync_s=20.0)
+    due.tick_once()
+    robot.radio.linked_to = LinkWithin(robot, 15.0)
+    robot.block_at = np.array([33.0, 6.0, 1.5])                      # no way back at all
+    back = ReturnToComms("back", ctx, max_replans=1)
+    assert run(back, ctx, robot, ticks=30) == Status.FAILURE
+    assert len(events(ctx, "csiro_return_failed")) == 1
+    due.tick_once()
+    assert due.status == Status.FAILURE                               # explores on meanwhile
+    ctx.clock.now_s += 20.0
+    due.tick_once()
+    assert due.status == Status.SUCCESS
+
+
 def test_return_to_region_without_a_region_is_done_at_once(tunnel):
     robot, ctx, st, _ = walked(tunnel)
     st.region = None
