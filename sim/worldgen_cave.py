@@ -287,8 +287,7 @@ def build_cave(plan: CavePlan, name: str, v: float) -> World:
     canvas = VoxelCanvas(lo, hi, v)
     for i, j in plan.edges:
         carve_cave_segment(canvas, plan.pos[i], plan.pos[j], plan.w[i], plan.w[j],
-                           plan.h[i], plan.h[j], plan.shape[i], plan.shape[j],
-                           math.tan(math.radians(CAVE_MAX_SLOPE_DEG)))
+                           plan.h[i], plan.h[j], plan.shape[i], plan.shape[j])
     for low, up, r in plan.shafts:
         carve_shaft(canvas, plan.pos[low][:2], r, plan.pos[low][2], plan.pos[up][2])
 

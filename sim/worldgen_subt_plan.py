@@ -17,7 +17,7 @@ import networkx as nx
 import numpy as np
 
 from .world import World
-from .worldgen_cave import CAVE_MAX_SLOPE_DEG, CAVE_REACH
+from .worldgen_cave import CAVE_REACH
 from .worldgen_geometry import (GRID_MARGIN_M, VoxelCanvas, assemble_world, carve_cave_segment, carve_chamber,
                                 carve_tunnel, cave_section_top, horizontal_frame)
 
@@ -125,7 +125,7 @@ class CoursePlan:
             elif p.shape == "cave":
                 ca, cb = self.cave[p.a], self.cave[p.b]
                 carve_cave_segment(canvas, pa, pb, ca.width, cb.width, ca.height, cb.height,
-                                   ca.shape, cb.shape, math.tan(math.radians(CAVE_MAX_SLOPE_DEG)))
+                                   ca.shape, cb.shape)
         for n, (r, h, upward) in self.chambers().items():
             carve_chamber(canvas, self.pos[n], r, h, upward)
 
