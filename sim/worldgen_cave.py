@@ -8,6 +8,7 @@ along the centreline, and :func:`build_cave` carves the plan into a grid.
 from __future__ import annotations
 
 import math
+from collections import Counter
 from dataclasses import dataclass, field
 
 import networkx as nx
@@ -279,15 +280,24 @@ def add_cave_upper(plan: CavePlan, shaft_h: float, length: float) -> float:
                      "change shaft_height_m")
 
 
+def joined_cap_rise(degree_a: int, degree_b: int) -> tuple[float, float]:
+    """The cap rise of a segment whose ends join ``degree`` segments each: the cave's
+    slope limit where another segment goes on, level at a dead end."""
+    rise = math.tan(math.radians(CAVE_MAX_SLOPE_DEG))
+    return (rise if degree_a > 1 else 0.0, rise if degree_b > 1 else 0.0)
+
+
 def build_cave(plan: CavePlan, name: str, v: float) -> World:
     """Carve the planned cave into a voxel grid and wrap it in a World."""
     s = plan.slabs()
     lo = np.array([(s[:, 0] - s[:, 2]).min(), (s[:, 1] - s[:, 2]).min(), s[:, 3].min()])
     hi = np.array([(s[:, 0] + s[:, 2]).max(), (s[:, 1] + s[:, 2]).max(), s[:, 4].max()])
     canvas = VoxelCanvas(lo, hi, v)
+    degree = Counter(n for edge in plan.edges for n in edge)
     for i, j in plan.edges:
         carve_cave_segment(canvas, plan.pos[i], plan.pos[j], plan.w[i], plan.w[j],
-                           plan.h[i], plan.h[j], plan.shape[i], plan.shape[j])
+                           plan.h[i], plan.h[j], plan.shape[i], plan.shape[j],
+                           joined_cap_rise(degree[i], degree[j]))
     for low, up, r in plan.shafts:
         carve_shaft(canvas, plan.pos[low][:2], r, plan.pos[low][2], plan.pos[up][2])
 

@@ -190,7 +190,8 @@ def cave_section_top(height_m: float) -> float:
 
 def carve_cave_segment(canvas: VoxelCanvas, a, b, width_a: float, width_b: float,
                        height_a: float, height_b: float,
-                       shape_a: np.ndarray, shape_b: np.ndarray) -> None:
+                       shape_a: np.ndarray, shape_b: np.ndarray,
+                       cap_rise: tuple[float, float] = (0.0, 0.0)) -> None:
     """Carve one piece of a natural cave passage between floor points a and b.
 
     The cross-section is an ellipse (semi-axes width/2 and height/1.6) whose
@@ -198,7 +199,11 @@ def carve_cave_segment(canvas: VoxelCanvas, a, b, width_a: float, width_b: float
     (``shape`` rows are (cos, sin) amplitudes of harmonics 1, 2, 3), with the
     bottom cut flat at the floor. Width, height and shape vary linearly from
     a to b; beyond the ends the section is swept round into a rounded cap, so
-    consecutive segments join smoothly.
+    consecutive segments join smoothly. The cap's floor rises away from the end
+    at ``cap_rise`` (slopes beyond a and beyond b): free space is the union of
+    the segments, so where another segment goes on from an end and climbs, a cap
+    with a level floor would undercut it and leave a step where the cap ends
+    (give 0 at a dead end, whose cap would become a steep bowl).
     """
     a = np.asarray(a, float)
     b = np.asarray(b, float)
@@ -232,7 +237,8 @@ def carve_cave_segment(canvas: VoxelCanvas, a, b, width_a: float, width_b: float
     r = (1.0 + coef[0][..., 0, None] * c + coef[0][..., 1, None] * s
          + coef[1][..., 0, None] * cos2 + coef[1][..., 1, None] * sin2
          + coef[2][..., 0, None] * cos3 + coef[2][..., 1, None] * sin3)
-    canvas.free[sl] |= (rho <= r) & (zs >= floor[..., None])
+    cut = floor + np.where(beyond < 0.0, cap_rise[0], cap_rise[1]) * np.abs(beyond)
+    canvas.free[sl] |= (rho <= r) & (zs >= cut[..., None])
 
 
 # --------------------------------------------------------------- clearances

@@ -11,13 +11,14 @@ its own (the hall, rooms and doors are boxes carved beside the graph).
 from __future__ import annotations
 
 import math
+from collections import Counter
 from dataclasses import dataclass, field
 
 import networkx as nx
 import numpy as np
 
 from .world import World
-from .worldgen_cave import CAVE_REACH
+from .worldgen_cave import CAVE_REACH, joined_cap_rise
 from .worldgen_geometry import (GRID_MARGIN_M, VoxelCanvas, assemble_world, carve_cave_segment, carve_chamber,
                                 carve_tunnel, cave_section_top, horizontal_frame)
 
@@ -113,6 +114,7 @@ class CoursePlan:
             carve_box(canvas, lo, hi)
         sloped = {n for p in self.passages if abs(self.pos[p.a][2] - self.pos[p.b][2]) > 1e-6
                   for n in (p.a, p.b)}
+        caves = Counter(n for p in self.passages if p.shape == "cave" for n in (p.a, p.b))
         for p in self.passages:
             pa, pb = self.pos[p.a], self.pos[p.b]
             if p.shape == "tunnel":
@@ -125,7 +127,7 @@ class CoursePlan:
             elif p.shape == "cave":
                 ca, cb = self.cave[p.a], self.cave[p.b]
                 carve_cave_segment(canvas, pa, pb, ca.width, cb.width, ca.height, cb.height,
-                                   ca.shape, cb.shape)
+                                   ca.shape, cb.shape, joined_cap_rise(caves[p.a], caves[p.b]))
         for n, (r, h, upward) in self.chambers().items():
             carve_chamber(canvas, self.pos[n], r, h, upward)
 

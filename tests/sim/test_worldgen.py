@@ -263,7 +263,10 @@ def blocked_walks(world):
         if d["kind"] == "shaft":
             continue
         for s, t in ((a, b), (b, a)):
-            robot = SimRobot("walker", LEGGED, world, g.nodes[s]["pos"], radio=None)
+            start = g.nodes[s]["pos"].copy()
+            ground = world.ground_height(start[None] + [0.0, 0.0, 0.6], 2.0)[0]
+            start[2] = ground if np.isfinite(ground) else start[2]     # a cave's floor may lie lower
+            robot = SimRobot("walker", LEGGED, world, start, radio=None)
             robot.follow_path(g.nodes[t]["pos"][None] + [0.0, 0.0, LEGGED.body_height_m])
             for _ in range(int(2 * d["length_m"] / (LEGGED.speed_mps * 0.1)) + 10):
                 if robot.path_status != FOLLOWING:
@@ -375,6 +378,14 @@ def test_cave_floors_are_walkable(small_cave):
     slopes = [slope_deg(small_cave, a, b) for a, b, d in g.edges(data=True)
               if d["kind"] == "cave"]
     assert max(slopes) <= 12.0 + 1e-6
+
+
+@pytest.mark.parametrize("seed", [2, 3])
+def test_cave_passages_are_walkable(seed):
+    """A segment's rounded cap rises away from an end where another segment goes on, so it
+    does not undercut one that climbs (seeds 2 and 3 had 0.4 m steps there)."""
+    w = worldgen.cave(seed, total_length_m=250.0, shaft=False, width_m=(2.0, 6.0), height_m=(2.0, 4.0))
+    assert blocked_walks(w) == []
 
 
 def test_cave_shaft_reaches_an_isolated_upper_passage(small_cave):
