@@ -12,11 +12,26 @@ from py_trees.common import Status
 from py_trees.ports import PortInformation
 
 from ...planners.geometry import path_length, xyz
-from ..base import Param, Skill
+from ..base import AgentContext, Param, Skill
 from ..motion_base import PathMotion
 from ..navigation import navigator
 from ..robot import PathStatus
 from .state import BASE, CsiroState, csiro_config, csiro_state
+
+
+def way_to(ctx: AgentContext, st: CsiroState, target: np.ndarray, replans: int) -> np.ndarray | None:
+    """Waypoints from the robot to ``target``: a ground robot's first plan follows the team's
+    topometric map; a flying robot, a re-plan (a straight step between topometric nodes can
+    cut a junction's corner through rock) or a target the map has no path to go by the
+    onboard map's navigation graph (rebuilt on a re-plan). None when neither has a way."""
+    r = ctx.robot
+    if replans == 0 and not r.mobility.aerial:
+        node = st.topometric.nearest_node(target)
+        found = None if node is None else st.topometric.path(r.position, node)
+        if found is not None and len(found.points) >= 2:
+            return found.points[1:]
+    path, _ = navigator(ctx, r).path_to_point(target, force=replans > 0)
+    return path if path is not None and len(path) else None
 
 
 class SyncDue(Skill):
@@ -79,14 +94,8 @@ class ReturnToComms(PathMotion):
         r = self.robot
         st = csiro_state(self.ctx, r.view_up_deg)
         target = st.contact if self.replans == 0 and st.contact is not None else r.home
-        path = None
-        if self.replans == 0 and not r.mobility.aerial:
-            node = st.topometric.nearest_node(target)
-            found = None if node is None else st.topometric.path(r.position, node)
-            path = None if found is None or len(found.points) < 2 else found.points[1:]
+        path = way_to(self.ctx, st, target, self.replans)
         if path is None:
-            path, _ = navigator(self.ctx, r).path_to_point(target, force=self.replans > 0)
-        if path is None or not len(path):
             path = np.asarray([r.home], float)
         self.drive(path)
         self.feedback_message = f"back to the link, {path_length(np.vstack([r.position, path])):.0f} m"
@@ -161,14 +170,8 @@ class ReturnToRegion(PathMotion):
 
     def plan(self) -> Status:
         r, st = self.robot, csiro_state(self.ctx)
-        path = None
-        if self.replans == 0 and not r.mobility.aerial:
-            node = st.topometric.nearest_node(st.region)
-            found = None if node is None else st.topometric.path(r.position, node)
-            path = None if found is None or len(found.points) < 2 else found.points[1:]
+        path = way_to(self.ctx, st, st.region, self.replans)
         if path is None:
-            path, _ = navigator(self.ctx, r).path_to_point(st.region, force=self.replans > 0)
-        if path is None or not len(path):
             return self.give_up(PathStatus.BLOCKED, "no path to the region")
         self.drive(path)
         self.event("csiro_return_to_region", region=xyz(st.region, 2),
