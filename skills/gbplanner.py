@@ -21,7 +21,7 @@ from py_trees.ports import PortInformation
 from ..planners.gbplanner2 import Frontier, GBPlanner, GBPlannerConfig, PlanResult
 from ..planners.gbplanner2.link_loss import LinkLoss
 from ..planners.gbplanner2.local_planner import ShrinkingLocalPlanner
-from ..planners.gbplanner2.planning_map import blocked_spot, mark_blocked_spots, sealed_grid, start_pose
+from ..planners.gbplanner2.planning_map import MapSealer, blocked_spot, mark_blocked_spots, start_pose
 from ..planners.geometry import path_length, xyz
 from ..planners.occupancy import Grid
 from .base import AgentContext, Param, Skill
@@ -378,9 +378,8 @@ class Explore(Skill):
         try:
             svc = gbplanner(self.ctx, r, self.overrides, self.p["seed"])
             bounds = parse_bbox(self.read("exploration_bbox"))
-            grid = onboard_grid(self.ctx, r)
-            if self.p["seal_map_holes"]:
-                grid = sealed_grid(grid)
+            grid = (navigator(self.ctx, r).updated("sealed map", MapSealer) if self.p["seal_map_holes"]
+                    else onboard_grid(self.ctx, r))
             mob = r.mobility
             below = 0.0 if mob.aerial else mob.body_height_m + grid.voxel_size_m
             grid = mark_blocked_spots(grid, svc.blocked_spots, self.p["no_go_radius_m"],

@@ -79,16 +79,16 @@ class Navigator:
         """The legged graph of the current map, updated from the voxels changed since the
         last build (built over the whole map the first time, or for a new map object)."""
         mob = self.robot.mobility
-        return self._updated("legged graph", lambda: LeggedGraphUpdater(
+        return self.updated("legged graph", lambda: LeggedGraphUpdater(
             body_height_m=mob.body_height_m, radius_m=mob.radius_m, max_step_m=mob.max_step_m,
             max_inclination_deg=mob.max_inclination_deg))
 
     def frontier_voxels(self) -> np.ndarray:
         """The frontier voxels of the current map (:func:`delve.planners.frontier.frontier_voxels`
         of :meth:`grid`, in its order), updated from the voxels changed since the last call."""
-        return self._updated("frontier voxels", FrontierUpdater)
+        return self.updated("frontier voxels", FrontierUpdater)
 
-    def _updated(self, name: str, make: Callable[[], Any]) -> Any:
+    def updated(self, name: str, make: Callable[[], Any]) -> Any:
         """``update`` of the incremental result ``name`` of the current map: from the voxels
         in the map's change log since the last call, or, the first time or for a new map
         object, from the whole map (with ``make()`` a new updater)."""

@@ -6,7 +6,7 @@ import numpy as np
 from delve.planners.gbplanner2 import synthetic as syn
 from delve.planners.gbplanner2.config import GBPlannerConfig
 from delve.planners.gbplanner2.local_map import LocalMap
-from delve.planners.gbplanner2.planning_map import blocked_spot, mark_blocked_spots, sealed_grid, start_pose
+from delve.planners.gbplanner2.planning_map import MapSealer, blocked_spot, mark_blocked_spots, sealed_grid, start_pose
 from delve.planners.occupancy import FREE, OCCUPIED, UNKNOWN, Grid
 
 
@@ -20,6 +20,24 @@ def test_sealed_grid_closes_one_voxel_gaps_in_the_rock_surface():
     assert out.occupancy[4, 4, 4] == UNKNOWN   # unknown, no rock beside it
     assert np.array_equal(out.occupancy == FREE, occ == FREE)
     assert grid.occupancy[1, 0, 0] == UNKNOWN  # the map itself is untouched
+
+
+def test_map_sealer_equals_sealing_the_whole_grid_after_each_change():
+    rng = np.random.default_rng(3)
+    occ = np.full((9, 7, 6), UNKNOWN, np.int8)
+    grid = Grid(occ, np.zeros(3), 0.2)
+    sealer = MapSealer()
+    first = sealer.update(grid)
+    assert np.array_equal(first.occupancy, sealed_grid(grid).occupancy)
+    for _ in range(40):
+        # Scans make voxels free or rock, rock turns free, a reset makes them unknown
+        # again; on the grid's faces and corners too.
+        changed = rng.choice(occ.size, size=int(rng.integers(0, 12)), replace=False)
+        occ.reshape(-1)[changed] = rng.choice([UNKNOWN, FREE, OCCUPIED], size=len(changed))
+        out = sealer.update(grid, changed)
+        assert np.array_equal(out.occupancy, sealed_grid(grid).occupancy)
+    assert out.occupancy is first.occupancy   # one array, kept up to date
+    assert sealer.update(Grid(np.full((4, 4, 4), OCCUPIED, np.int8), np.zeros(3), 0.2), changed).shape == (4, 4, 4)
 
 
 def test_blocked_spot_and_its_rock():
