@@ -202,9 +202,3 @@ class VoxelMap:
         self._log(flat[merged != current])
         occ[flat] = merged
         self.version += 1
-
-    def known_fraction_of(self, flat: np.ndarray) -> float:
-        """Fraction of the voxels ``flat`` that this map knows as FREE."""
-        if len(flat) == 0:
-            return 0.0
-        return float(np.count_nonzero(self.occupancy.reshape(-1)[flat] == FREE) / len(flat))

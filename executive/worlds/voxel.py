@@ -24,6 +24,7 @@ from ..errors import DelveError
 from ..yamlio import YamlDict, file_problem, line_of_key_named
 from .base import BASE, Coverage, TeamNetwork, WorldBackend, WorldDescription, only_keys
 from .voxel_check import describe_voxel_world, place_starts
+from .voxel_coverage import TruthCoverage
 from .voxel_plot import plot_voxel_map
 from .voxel_preview import draw_preview
 
@@ -111,6 +112,7 @@ class VoxelBackend(WorldBackend):
         reach = world.reachable_free(self.first_start())
         #: Flat indices of the free voxels the team should explore (ground truth).
         self.truth = np.flatnonzero(reach.reshape(-1))
+        self._coverage = TruthCoverage(self.truth)
 
     def _robot(self, spec: "RobotSpec", start: np.ndarray) -> SimRobot:
         base = PLATFORMS[spec.platform]
@@ -151,14 +153,10 @@ class VoxelBackend(WorldBackend):
         self._next_scan[name] = now_s + 1.0 / robot.mobility.lidar.rate_hz
 
     def coverage(self, explored_at_base: set[str]) -> Coverage:
-        team = np.zeros(len(self.truth), dtype=bool)
-        per_robot = {}
-        for name, robot in self.robots.items():
-            seen = robot.onboard_map.occupancy.reshape(-1)[self.truth] == 0
-            per_robot[name] = round(float(seen.mean()) if len(seen) else 0.0, 5)
-            team |= seen
-        return Coverage(team=round(float(team.mean()) if len(team) else 0.0, 5),
-                        base=round(self.base_map.known_fraction_of(self.truth), 5), robots=per_robot)
+        cov = self._coverage
+        per_robot = {name: round(cov.fraction(name, robot.onboard_map), 5) for name, robot in self.robots.items()}
+        return Coverage(team=round(cov.team_fraction, 5),
+                        base=round(cov.fraction(BASE, self.base_map, in_team=False), 5), robots=per_robot)
 
     def network(self, contexts: dict[str, AgentContext], cell_m: float) -> TeamNetwork:
         """Every robot's network view uses one lattice, with a cell centred on the first
