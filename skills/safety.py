@@ -45,14 +45,17 @@ class RobotStuck(Skill):
         self.history.append((now, r.position))
         while len(self.history) > 1 and now - self.history[1][0] >= self.p["stuck_time_s"]:
             self.history.popleft()
-        t0 = self.history[0][0]
-        spread = max(float(np.linalg.norm(r.position - p)) for _, p in self.history)
-        if now - t0 >= self.p["stuck_time_s"] and spread < self.p["min_motion_m"]:
+        if now - self.history[0][0] >= self.p["stuck_time_s"] and self._still(r.position):
             self.history.clear()
             self.feedback_message = f"no motion for {self.p['stuck_time_s']:.0f} s"
             self.event("watchdog", trigger=True, position=xyz(r.position, 2))
             return Status.SUCCESS
         return Status.FAILURE
+
+    def _still(self, here: np.ndarray) -> bool:
+        """Whether every kept position lies within ``min_motion_m`` of ``here``; the
+        oldest first, which for a robot under way is the far one (one test a tick)."""
+        return all(float(np.linalg.norm(here - p)) < self.p["min_motion_m"] for _, p in self.history)
 
 
 class BudgetElapsed(Skill):
