@@ -29,8 +29,6 @@ IDLE, FOLLOWING, ARRIVED, BLOCKED = "idle", "following", "arrived", "blocked"
 #: Range-sensor sweeps a robot keeps for ``take_lidar_scans`` (the oldest go first).
 LIDAR_SCANS_KEPT = 20
 _GOLDEN = (math.sqrt(5) - 1) / 2
-#: The direction of a ground probe.
-_DOWN = np.array([[0.0, 0.0, -1.0]])
 
 
 class SimRobot(RobotBody):
@@ -352,10 +350,10 @@ class SimRobot(RobotBody):
         """Height of the rock surface under (x, y) near the current ground, by a ray cast
         down onto the world mesh (continuous, unlike the voxel grid); NaN if none."""
         reach = self._platform.max_step_m + 0.3
-        probe = np.array([[x, y, self._ground + reach]])
-        if not self.world.is_free_at(float(probe[0, 0]), float(probe[0, 1]), float(probe[0, 2])):
+        x, y, z = float(x), float(y), float(self._ground + reach)
+        if not self.world.is_free_at(x, y, z):
             return math.nan
-        d = float(self.world.cast_rays(probe, _DOWN, 2 * reach)[0])
+        d = self.world.distance_down(x, y, z, 2 * reach)
         return self._ground + reach - d if math.isfinite(d) else math.nan
 
     def _block(self, reason: str) -> bool:

@@ -106,6 +106,8 @@ class World:
         default=None, init=False, repr=False)
     _labels: np.ndarray | None = field(default=None, init=False, repr=False)
     _reachable: dict = field(default_factory=dict, init=False, repr=False)
+    #: One downward ray (float32 (1, 6)) and the open3d tensor that shares its memory.
+    _down_ray: tuple[np.ndarray, o3d.core.Tensor] | None = field(default=None, init=False, repr=False)
 
     def __post_init__(self) -> None:
         self.voxel_size_m = float(self.voxel_size_m)
@@ -123,7 +125,7 @@ class World:
         mesh = state.pop("mesh")
         state["_mesh_arrays"] = (np.asarray(mesh.vertices).copy(),
                                  np.asarray(mesh.triangles).copy())
-        state.update(_scene=None, _labels=None, _reachable={})
+        state.update(_scene=None, _labels=None, _reachable={}, _down_ray=None)
         return state
 
     def __setstate__(self, state: dict) -> None:
@@ -232,6 +234,20 @@ class World:
         t = self.scene.cast_rays(o3d.core.Tensor.from_numpy(rays))["t_hit"].numpy()
         t[~(t <= np.float32(max_range_m))] = np.inf
         return t
+
+    def distance_down(self, x: float, y: float, z: float, max_range_m: float) -> float:
+        """Distance straight down from (x, y, z) to the first rock hit, as
+        :meth:`cast_rays` of that one ray (np.inf beyond ``max_range_m``). A legged
+        robot's ground probe, every sim step: the ray is written into a kept buffer
+        that open3d reads in place, half the cost of a :meth:`cast_rays` call."""
+        if self._down_ray is None:
+            buf = np.zeros((1, 6), dtype=np.float32)
+            buf[0, 5] = -1.0
+            self._down_ray = (buf, o3d.core.Tensor.from_numpy(buf))
+        buf, rays = self._down_ray
+        buf[0, 0], buf[0, 1], buf[0, 2] = x, y, z
+        t = float(self.scene.cast_rays(rays)["t_hit"].numpy()[0])
+        return t if t <= float(np.float32(max_range_m)) else math.inf
 
     def line_of_sight(self, a: np.ndarray, b: np.ndarray) -> bool:
         """True when no rock lies on the straight segment from a to b."""

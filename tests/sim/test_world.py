@@ -102,6 +102,16 @@ def test_rays_beyond_range_and_empty(twin):
         twin.cast_rays(np.zeros((2, 3)), np.zeros((3, 3)), 10.0)
 
 
+def test_distance_down_is_cast_rays_of_one_ray(twin):
+    down = np.array([[0.0, 0.0, -1.0]])
+    rng = np.random.default_rng(2)
+    for x, y, z in rng.uniform([0.0, -1.5, 0.1], [30.0, 13.5, 2.5], (40, 3)):
+        for reach in (0.5, 3.0):
+            assert twin.distance_down(x, y, z, reach) == twin.cast_rays(np.array([[x, y, z]]), down, reach)[0]
+    assert twin.distance_down(15.0, 0.0, 1.0, 2.0) == pytest.approx(1.0, abs=0.25)
+    assert math.isinf(twin.distance_down(15.0, 6.0, 1.0, 0.5))   # in rock: the mesh is beyond reach
+
+
 def test_a_sweep_of_many_rays_all_hit_a_closed_tunnel(twin):
     """A LiDAR-sized batch (its time: bench/hot_paths.py)."""
     rng = np.random.default_rng(0)
