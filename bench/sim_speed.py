@@ -3,6 +3,7 @@ planning and ticking.
 
     .venv/bin/python bench/sim_speed.py [--scenario scenarios/demo.yaml] [--runs 3] [--duration-s S]
     .venv/bin/python bench/sim_speed.py --runs 3 --baseline /tmp/vb/bin/python
+    .venv/bin/python bench/sim_speed.py --scenario subt_final --duration-s 1200 --runs 2 --baseline /tmp/vb/bin/python
 
 Prints the median over the runs and the process's peak resident memory. The shares
 come from timing the functions that do each kind of work (wrapped here, in the
@@ -29,8 +30,8 @@ import time
 from collections import defaultdict
 from pathlib import Path
 
-import delve
 from delve.executive import agent as agent_mod
+from delve.executive.cli import shipped_or_given
 from delve.executive.runner import Mission
 from delve.executive.scenario import load_scenario
 from delve.planners import frontier, navgraph
@@ -152,7 +153,8 @@ def compare(args: argparse.Namespace) -> int:
 
 def main() -> int:
     ap = argparse.ArgumentParser()
-    ap.add_argument("--scenario", type=Path, help="default: the demo of the checkout that runs (its scenarios/demo.yaml)")
+    ap.add_argument("--scenario", type=Path, help="a scenario file, or the name of a shipped one (each checkout's "
+                    "own with --baseline); default: demo")
     ap.add_argument("--runs", type=int, default=3)
     ap.add_argument("--duration-s", type=float, help="override the scenario's duration (sim seconds)")
     ap.add_argument("--baseline", help="python of a virtual environment with the baseline checkout installed")
@@ -160,7 +162,7 @@ def main() -> int:
     args = ap.parse_args()
     if args.baseline:
         return compare(args)
-    scenario = load_scenario(args.scenario or Path(delve.__file__).parents[1] / "scenarios" / "demo.yaml")
+    scenario = load_scenario(shipped_or_given(args.scenario or Path("demo")))
     world = scenario.build_world()
     instrument()
     rows = [run_once(scenario, world, args.duration_s) for _ in range(args.runs)]
