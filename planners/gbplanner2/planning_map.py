@@ -2,10 +2,10 @@
 
 A robot's map has gaps in its rock surface and cannot show a step or trench finer
 than its voxels; the exploration skill hands the planner a map with those gaps sealed
-(:func:`sealed_grid`, kept up to date by :class:`MapSealer`) and with rock where a commanded path turned out blocked
-(:func:`blocked_spot`, :func:`mark_blocked_spots`), and starts it from a pose whose
-robot box is clear of rock (:func:`start_pose`). Pure numpy on a
-:class:`~delve.planners.occupancy.Grid`.
+(:func:`sealed_grid`, kept up to date by :class:`MapSealer`) and with rock where a
+commanded path turned out blocked (:func:`blocked_spot`, :func:`mark_blocked_spots`),
+and starts it from a pose whose robot box is clear of rock (:func:`start_pose`). Pure
+numpy on a :class:`~delve.planners.occupancy.Grid`.
 """
 from __future__ import annotations
 
