@@ -75,15 +75,17 @@ def line_of_sight(voxel_map: OccupancyMap, eye: np.ndarray, target_ijk: np.ndarr
             continue
         t = (np.arange(math.ceil(float(dist.max()) / step), dtype=np.float32) + np.float32(0.5)) * step
         direction = rel / np.maximum(dist, np.float32(1e-6))[:, None]
-        idx = np.floor(start_v + direction[:, None, :] * t[None, :, None]).astype(np.int32)
-        check = t[None, :] < dist[:, None]
-        check &= (np.abs(idx - ijk[:, None, :]) > 1).any(axis=2)
-        check &= ((idx >= 0) & (idx < shape)).all(axis=2)
+        # Each ray's samples before its target only (t < dist: a prefix of t), as one
+        # ragged batch: half the samples of a rectangular one.
+        n = np.searchsorted(t, dist, side="left")
+        ray = np.repeat(np.arange(len(ijk)), n)
+        k = np.arange(len(ray)) - np.repeat(np.cumsum(n) - n, n)
+        idx = np.floor(start_v + direction[ray] * t[k][:, None]).astype(np.int32)
+        check = (np.abs(idx - ijk[ray]) > 1).any(axis=1) & ((idx >= 0) & (idx < shape)).all(axis=1)
         i = idx[check]
         flat = (i[:, 0].astype(np.int64) * shape[1] + i[:, 1]) * shape[2] + i[:, 2]
-        blocked = np.zeros(check.shape, dtype=bool)
-        blocked[check] = flat_occ[flat] == OCCUPIED
-        out[first:first + len(ijk)] = ~blocked.any(axis=1)
+        blocked = np.bincount(ray[check][flat_occ[flat] == OCCUPIED], minlength=len(ijk)) > 0
+        out[first:first + len(ijk)] = ~blocked
     return out
 
 

@@ -39,6 +39,37 @@ def test_line_of_sight_is_blocked_by_rock_on_the_map():
     assert line_of_sight(m, eye, near_wall)[0]
 
 
+def _sight_one_ray(m: Grid, eye: np.ndarray, target: np.ndarray) -> bool:
+    """The definition, one target at a time: samples half a voxel apart (float32, voxel
+    units) up to the target's centre; blocked by rock outside its 26 neighbours."""
+    start = ((eye - m.origin) / m.voxel_size_m).astype(np.float32)
+    rel = target.astype(np.float32) + np.float32(0.5) - start
+    dist = np.linalg.norm(rel)
+    direction = rel / max(dist, np.float32(1e-6))
+    for k in range(int(np.ceil(dist / np.float32(0.5))) + 1):
+        t = (np.float32(k) + np.float32(0.5)) * np.float32(0.5)
+        if not t < dist:
+            break
+        i = np.floor(start + direction * t).astype(np.int32)
+        inside = np.all((i >= 0) & (i < np.array(m.occupancy.shape)))
+        if inside and np.abs(i - target).max() > 1 and m.occupancy[tuple(i)] == OCCUPIED:
+            return False
+    return True
+
+
+def test_line_of_sight_equals_marching_each_ray_on_its_own():
+    rng = np.random.default_rng(4)
+    for _ in range(6):
+        occ = (rng.random((40, 40, 20)) < rng.uniform(0.02, 0.1)).astype(np.int8)
+        m = Grid(occ, np.array([-1.0, 2.0, 0.5]), 0.2)
+        eye = m.origin + rng.uniform([2, 2, 1], [6, 6, 3])
+        ijk, _ = surface_voxels(m, eye, 4.0)
+        ijk = np.vstack([ijk[:150], rng.integers(-3, 43, (20, 3))])   # some outside the grid
+        seen = line_of_sight(m, eye, ijk)
+        assert seen.any() and not seen.all()
+        assert seen.tolist() == [_sight_one_ray(m, eye, t) for t in ijk]
+
+
 def test_first_hit_is_the_nearest_rock_along_each_direction(tunnel):
     grid, start, _ = tunnel
     eye = np.asarray(start, float) + np.array([8.0, 0.0, 1.0])       # 1 m above the floor
