@@ -350,21 +350,28 @@ class ArtifactSensors:
                      payload: PanTiltZoomCamera | None) -> list[_Camera]:
         s = self.spec
         cams = []
-        mount = trans + rot @ np.asarray(s.camera_mount_m, float)
-        for name, body_axes in zip(s.camera_names, self._body_axes):
-            if self._frame_due(name, t_s, s.inference_rate_hz):
-                cams.append(_Camera(name, mount, body_axes @ rot.T, _tan_half(
-                    s.camera_horizontal_fov_deg, s.camera_vertical_fov_deg),
-                    s.camera_range_m, s.visual_classes))
+        # Where the cameras are is worked out only when one of them takes a frame
+        # (most calls take none: the cameras run slower than the loop).
+        due = [(name, body_axes) for name, body_axes in zip(s.camera_names, self._body_axes)
+               if self._frame_due(name, t_s, s.inference_rate_hz)]
+        if due:
+            mount = trans + rot @ np.asarray(s.camera_mount_m, float)
+            cams = [_Camera(name, mount, body_axes @ rot.T, _tan_half(
+                s.camera_horizontal_fov_deg, s.camera_vertical_fov_deg), s.camera_range_m, s.visual_classes)
+                for name, body_axes in due]
         if payload is None:
+            return cams
+        zoom, thermal = self._frame_due("zoom", t_s, s.inference_rate_hz), self._frame_due("thermal", t_s,
+                                                                                         s.thermal_rate_hz)
+        if not (zoom or thermal):
             return cams
         origin = payload.camera_position(np.vstack([np.c_[rot, trans], [0, 0, 0, 1]]))
         axes = (rot @ np.vstack(camera_axes(payload.yaw_deg, payload.pitch_deg)).T).T
-        if self._frame_due("zoom", t_s, s.inference_rate_hz):
+        if zoom:
             h, v = payload.spec.horizontal_fov_deg, payload.spec.vertical_fov_deg
             cams.append(_Camera("zoom", origin, axes, _tan_half(h, v, payload.zoom),
                                 self.zoom_range_m(payload.zoom), s.visual_classes))
-        if self._frame_due("thermal", t_s, s.thermal_rate_hz):
+        if thermal:
             cams.append(_Camera("thermal", origin, axes, _tan_half(s.thermal_horizontal_fov_deg,
                                                                    s.thermal_vertical_fov_deg),
                                 s.thermal_range_m, s.thermal_classes))
