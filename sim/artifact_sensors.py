@@ -361,8 +361,8 @@ class ArtifactSensors:
                 for name, body_axes in due]
         if payload is None:
             return cams
-        zoom, thermal = self._frame_due("zoom", t_s, s.inference_rate_hz), self._frame_due("thermal", t_s,
-                                                                                         s.thermal_rate_hz)
+        zoom = self._frame_due("zoom", t_s, s.inference_rate_hz)
+        thermal = self._frame_due("thermal", t_s, s.thermal_rate_hz)
         if not (zoom or thermal):
             return cams
         origin = payload.camera_position(np.vstack([np.c_[rot, trans], [0, 0, 0, 1]]))
