@@ -1,4 +1,5 @@
 """The global planner: global graph, repositioning, homing, goals."""
+import networkx as nx
 import numpy as np
 import pytest
 from delve.planners.gbplanner2 import synthetic as s
@@ -127,6 +128,33 @@ def test_frontiers_are_dropped_once_explored(tunnel):
     gp.update_frontiers(mapped)
     assert not gp.frontiers
     assert not gp.plan_reposition(mapped, home).ok
+
+
+def test_new_vertices_are_joined_to_their_neighbours(tunnel):
+    """Out along one side of the tunnel and back along the other: the global graph joins
+    the two tracks where an admissible edge does (gbplanner's RRG), so the way between
+    them is not the way the robot came."""
+    g, a, home = tunnel
+    out = home + np.array([[x, 0.8, 0] for x in np.arange(1.0, 30.0, 1.5)])
+    back = home + np.array([[x, -0.8, 0] for x in np.arange(28.5, 1.0, -1.5)])
+
+    def across(grid):
+        """Graph distance between the two tracks 20 m in, after driving out and back."""
+        gp = GlobalPlanner(CFG, home)
+        lm = None if grid is None else LocalMap(grid, a - 2, a + np.array([42.0, 2, 2]), CFG)
+        for path in (out, back):
+            gp.add_local_result(LocalPlanResult(path=path, gain=1e3, reason="", diagnostics=PlanDiagnostics(),
+                                                root=path[0], local_map=lm))
+        u, v = (int(np.argmin(np.linalg.norm(gp.positions - (home + [20.0, y, 0]), axis=1))) for y in (0.8, -0.8))
+        return nx.shortest_path_length(gp.graph, u, v, weight="weight")
+
+    assert across(g) < 2.5
+    assert across(None) > 15.0  # no map to check edges on: the track only
+    # rock along the tunnel's axis beyond 2 m: the tracks are not joined through it
+    occ = g.occupancy.copy()
+    i, j, _ = g.to_index(home[None])[0]
+    occ[i + 10:, j - 1:j + 2, :] = OCCUPIED
+    assert across(Grid(occ, g.origin, g.voxel_size_m)) > 15.0
 
 
 def test_invalid_home_raises():
