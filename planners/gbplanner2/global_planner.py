@@ -152,12 +152,17 @@ class GlobalPlanner:
         return ids
 
     # --- recording what the robot did and saw -------------------------------------------
-    def record_position(self, position: np.ndarray) -> int:
+    def record_position(self, position: np.ndarray, grid: Grid | None = None) -> int:
         """The robot is at ``position``: add it as a visited vertex joined to the last one
-        (the robot went from there to here, so the edge is traversable)."""
+        (the robot went from there to here, so the edge is traversable) and, with
+        ``grid``, to its neighbours (:meth:`_link_neighbours`)."""
+        first_new = len(self._positions)
         v = self._add_vertex(np.asarray(position, float), "visited")
         self._add_edge(self.robot_vertex, v)
         self.robot_vertex = v
+        if grid is not None and v >= first_new:
+            p, r = self._positions[v], self.config.neighbour_radius_m
+            self._link_neighbours(LocalMap(grid, p - r, p + r, self.config, clear_box_at=p), np.array([v]))
         return v
 
     def add_local_result(self, result: LocalPlanResult, grid: Grid | None = None) -> list[Frontier]:
@@ -207,7 +212,7 @@ class GlobalPlanner:
         u = np.repeat(new, k)
         v, d = near.reshape(-1), d.reshape(-1)
         # Each pair once: an old vertex, or a new one with a smaller id; not already joined.
-        keep = np.isfinite(d) & (d > cfg.edge_length_min_m) & ((v < new[0]) | (v < u))
+        keep = np.isfinite(d) & (d > cfg.edge_length_min_m) & (~np.isin(v, new) | (v < u))
         pairs = [(int(a), int(b)) for a, b in zip(u[keep], v[keep]) if not self.graph.has_edge(a, b)]
         if not pairs:
             return

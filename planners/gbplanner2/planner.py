@@ -86,7 +86,7 @@ class GBPlanner:
         gp = self.global_planner
         if not np.all(np.isfinite(position)):
             return PlanResult(None, "none", reason="robot position is not finite")
-        gp.record_position(position)
+        gp.record_position(position, grid)
         check = None
         if endurance_remaining_s is not None:
             check = gp.homing_check(grid, position, float(endurance_remaining_s))

@@ -108,7 +108,7 @@ class ReturnToLinkPoint(GoTo):
 
     def update(self) -> Status:
         status = super().update()
-        record_transit(self.ctx, self.robot.position, self.p["graph_spacing_m"])
+        record_transit(self.ctx, self.robot, self.p["graph_spacing_m"])
         return status
 
     def arrived(self) -> Status:

@@ -17,8 +17,9 @@ from py_trees.ports import PortInformation
 from ...planners.cohort import CohortParams
 from ...planners.geometry import xyz
 from ..base import AgentContext, Param, Skill, mailbox
-from ..gbplanner import SERVICE as GBPLANNER_SERVICE
+from ..gbplanner import SERVICE as GBPLANNER_SERVICE, onboard_grid
 from ..motion import GoTo
+from ..robot import Robot
 from .hub import ASSIGNMENT, PARAMS_SERVICE, REQUEST, SUBMAP
 
 #: Who the hub is on the radio.
@@ -32,10 +33,10 @@ def cohort_params(ctx: AgentContext) -> CohortParams:
     return ctx.services.get(PARAMS_SERVICE) or CohortParams()
 
 
-def record_transit(ctx: AgentContext, position: np.ndarray, spacing_m: float) -> None:
-    """Add ``position`` to the agent's GBPlanner2 global graph as a visited vertex joined
-    to the last one, when it lies ``spacing_m`` or more from it (nothing when the agent
-    has no GBPlanner2). A COHORT transit (the hub's path, the way back to a link point)
+def record_transit(ctx: AgentContext, robot: Robot, spacing_m: float) -> None:
+    """Add the robot's position to the agent's GBPlanner2 global graph as a visited
+    vertex joined to the last one and to its neighbours on the onboard map, when it lies
+    ``spacing_m`` or more from the last one (nothing when the agent has no GBPlanner2). A COHORT transit (the hub's path, the way back to a link point)
     runs outside the explorer, and the global graph only records where the explorer
     planned: without these vertices the next plan would join the end of the transit to
     its start by one straight edge, through rock, which is cut when checked and leaves
@@ -44,8 +45,9 @@ def record_transit(ctx: AgentContext, position: np.ndarray, spacing_m: float) ->
     if svc is None:
         return
     gp = svc.planner.global_planner
-    if np.linalg.norm(np.asarray(position, float) - gp.position_of(gp.robot_vertex)) >= spacing_m:
-        gp.record_position(np.asarray(position, float))
+    position = np.asarray(robot.position, float)
+    if np.linalg.norm(position - gp.position_of(gp.robot_vertex)) >= spacing_m:
+        gp.record_position(position, onboard_grid(ctx, robot))
 
 
 def linked(radio: Any, attempts: int, other: str = HUB) -> bool:
@@ -261,7 +263,7 @@ class FollowHubPath(GoTo):
             self.feedback_message = "no frontier assigned"
             return Status.SUCCESS
         status = super().update()
-        record_transit(self.ctx, self.robot.position, self.p["graph_spacing_m"])
+        record_transit(self.ctx, self.robot, self.p["graph_spacing_m"])
         return status
 
     def _path(self, grid: Any) -> tuple[np.ndarray | None, str, str, str]:

@@ -157,6 +157,22 @@ def test_new_vertices_are_joined_to_their_neighbours(tunnel):
     assert across(Grid(occ, g.origin, g.voxel_size_m)) > 15.0
 
 
+def test_recorded_positions_are_joined_to_their_neighbours(tunnel):
+    """A position recorded with the map (each plan, a COHORT transit) is joined to the
+    vertices beside it; without the map only to the last one."""
+    g, _a, home = tunnel
+
+    def across(grid):
+        gp = GlobalPlanner(CFG, home)
+        for x, y in [(x, 0.8) for x in np.arange(2.0, 20.0, 2.0)] + [(x, -0.8) for x in np.arange(18.0, 0.0, -2.0)]:
+            gp.record_position(home + [x, y, 0], grid)
+        u, v = (int(np.argmin(np.linalg.norm(gp.positions - (home + [10.0, y, 0]), axis=1))) for y in (0.8, -0.8))
+        return nx.shortest_path_length(gp.graph, u, v, weight="weight")
+
+    assert across(g) < 2.5
+    assert across(None) > 15.0
+
+
 def test_invalid_home_raises():
     with pytest.raises(ValueError):
         GlobalPlanner(CFG, np.array([np.nan, 0, 0]))
