@@ -36,11 +36,12 @@ def cohort_params(ctx: AgentContext) -> CohortParams:
 def record_transit(ctx: AgentContext, robot: Robot, spacing_m: float) -> None:
     """Add the robot's position to the agent's GBPlanner2 global graph as a visited
     vertex joined to the last one and to its neighbours on the onboard map, when it lies
-    ``spacing_m`` or more from the last one (nothing when the agent has no GBPlanner2). A COHORT transit (the hub's path, the way back to a link point)
-    runs outside the explorer, and the global graph only records where the explorer
-    planned: without these vertices the next plan would join the end of the transit to
-    its start by one straight edge, through rock, which is cut when checked and leaves
-    the frontiers and home on the far side unreachable in the robot's own graph."""
+    ``spacing_m`` or more from the last one (nothing when the agent has no GBPlanner2).
+    A COHORT transit (the hub's path, the way back to a link point) runs outside the
+    explorer, and the global graph only records where the explorer planned: without
+    these vertices the next plan would join the end of the transit to its start by one
+    straight edge, through rock, which is cut when checked and leaves the frontiers and
+    home on the far side unreachable in the robot's own graph."""
     svc = ctx.services.get(GBPLANNER_SERVICE)
     if svc is None:
         return
