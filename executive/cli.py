@@ -139,6 +139,8 @@ def run(path: Path, out: Path | None, seed: int | None, duration_s: float | None
     if duration_s is not None and (not math.isfinite(duration_s) or not duration_s > 0):
         raise DelveError(f"--duration-s must be a finite number of seconds > 0, got {duration_s}")
     scenario = load_scenario(path, include_path=include_path)
+    if seed is not None:
+        scenario.seed = seed  # the world, its description and the mission all take it
     if duration_s is not None and steps_problem(duration_s, scenario.dt_s):
         raise DelveError(f"--duration-s {steps_problem(duration_s, scenario.dt_s)}")
     if duration_s is not None and duration_s < scenario.duration_s:  # those after the file's end were named
@@ -146,10 +148,10 @@ def run(path: Path, out: Path | None, seed: int | None, duration_s: float | None
     out = out or Path("delve-out") / scenario.name
     check_out_dir(out)
     started = time.perf_counter()
-    loaded = scenario.build_world(seed)
+    loaded = scenario.build_world()
     if not _print_world(scenario.world_backend.describe(scenario, loaded), quiet):
         return 2
-    mission = Mission(scenario, seed=seed, duration_s=duration_s, world=loaded)
+    mission = Mission(scenario, duration_s=duration_s, world=loaded)
     if quiet:
         mission.run()
     else:
@@ -183,9 +185,11 @@ def world(path: Path, preview: Path | None, seed: int | None, include_path: tupl
     if seed is not None and seed < 0:
         raise DelveError(f"--seed must be >= 0, got {seed}")
     scenario = load_scenario(path, include_path=include_path)
+    if seed is not None:
+        scenario.seed = seed
     if preview is not None:
         check_out_dir(preview, "--preview")
-    loaded = scenario.build_world(seed)
+    loaded = scenario.build_world()
     ok = _print_world(scenario.world_backend.describe(scenario, loaded), quiet=False)
     if preview is not None:
         for written in scenario.world_backend.preview(scenario, loaded, preview):

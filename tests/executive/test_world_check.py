@@ -97,6 +97,16 @@ def test_delve_world_prints_the_world_and_draws_it(tmp_path, capsys):
     assert err.count("\n") == 1 and err.startswith("warning: ") and "encloses solids" in err
 
 
+def test_the_description_names_the_seed_the_world_was_made_with(tmp_path, capsys):
+    path = tmp_path / "gen.yaml"
+    path.write_text("name: gen\nseed: 7\nduration_s: 10\nworld: {generator: tunnel_network, total_length_m: 60, loops: 0}\n"
+                    f"robots:\n  - {{name: anymal, platform: legged, tree: {TREES_DIR}/frontier_explorer.yaml}}\n")
+    assert main(["world", str(path)]) == 0
+    assert capsys.readouterr().out.startswith("world gen: generator tunnel_network (seed 7, total_length_m 60, loops 0)")
+    assert main(["world", str(path), "--seed", "5"]) == 0
+    assert capsys.readouterr().out.startswith("world gen: generator tunnel_network (seed 5, total_length_m 60, loops 0)")
+
+
 def test_delve_world_warns_about_the_header_s_up_axis(tmp_path, capsys):
     # the drift runs along y, 20 m: read y up, it stands 20 m tall
     drift = slab_and_wall(length=20.0, dead_end=True)
