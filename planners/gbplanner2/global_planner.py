@@ -339,7 +339,10 @@ class GlobalPlanner:
         self, grid: Grid, position: np.ndarray, endurance_remaining_s: float | None = None
     ) -> GlobalPlanResult:
         """A path to the best frontier: gain / (path length + ``frontier_distance_offset_m``),
-        among frontiers from which the robot can still get home within its endurance."""
+        among frontiers from which the robot can still get home within its endurance
+        (along the graph, or, where an edge found blocked cut a frontier off from home on
+        the graph, in a straight line, as :meth:`homing_check` estimates it: before, such
+        frontiers were all "not reachable within the endurance" and the robot gave up)."""
         cfg = self.config
         self.update_frontiers(grid)
         if not self.frontiers:
@@ -354,7 +357,9 @@ class GlobalPlanner:
             if v not in dist:
                 continue
             if endurance_remaining_s is not None:
-                need = (dist[v] + home_dist.get(v, math.inf)) / cfg.speed_mps + cfg.homing_margin_s
+                # No way home on the graph: the straight line, as homing_check estimates it.
+                back = home_dist.get(v, float(np.linalg.norm(f.position - self.home)))
+                need = (dist[v] + back) / cfg.speed_mps + cfg.homing_margin_s
                 if need > endurance_remaining_s:
                     continue
             score = f.gain / (dist[v] + cfg.frontier_distance_offset_m)

@@ -81,6 +81,21 @@ def test_reposition_respects_the_endurance(tunnel):
     assert not rep.ok and "endurance" in rep.reason
 
 
+def test_a_frontier_cut_off_from_home_on_the_graph_is_judged_by_the_straight_line_home(tunnel):
+    """An edge found blocked cut the robot's part of the graph from home's: its frontiers
+    are still explored when the endurance covers the way to them and the straight line
+    home (as the homing check estimates it), and not when it does not."""
+    g, a, home = tunnel
+    p = a + np.array([30.0, 0, 0.5])
+    gp, _ = explored(tunnel, [p])
+    assert gp.frontiers
+    gp.graph.remove_edges_from(list(gp.graph.edges(gp.home_vertex)))
+    assert not nx.has_path(gp.graph, gp.robot_vertex, gp.home_vertex)
+    assert gp.plan_reposition(g, p, endurance_remaining_s=3600.0).ok
+    short = np.linalg.norm(p - home) / CFG.speed_mps + CFG.homing_margin_s
+    assert not gp.plan_reposition(g, p, endurance_remaining_s=short).ok
+
+
 def test_homing_triggers_only_when_endurance_is_short(tunnel):
     g, a, home = tunnel
     p = a + np.array([30.0, 0, 0.5])
