@@ -155,7 +155,8 @@ class GlobalPlanner:
     def record_position(self, position: np.ndarray, grid: Grid | None = None) -> int:
         """The robot is at ``position``: add it as a visited vertex joined to the last one
         (the robot went from there to here, so the edge is traversable) and, with
-        ``grid``, to its neighbours (:meth:`_link_neighbours`)."""
+        ``grid`` and unless it merged into an existing vertex, to its neighbours
+        (:meth:`_link_neighbours`)."""
         first_new = len(self._positions)
         v = self._add_vertex(np.asarray(position, float), "visited")
         self._add_edge(self.robot_vertex, v)
@@ -197,23 +198,22 @@ class GlobalPlanner:
         return added
 
     def _link_neighbours(self, local_map: LocalMap, new: np.ndarray) -> None:
-        """Join each of the ``new`` vertices to the (at most ``neighbours_max``) vertices
-        within ``neighbour_radius_m`` that an admissible edge of ``local_map`` reaches, as
-        gbplanner's RRG does for its global graph (``Rrg::expandGraph``): without these
-        edges the graph is the robot's track, and a way home or to a frontier follows
-        every detour the robot made (a path home of 114 m from 28 m away was seen)."""
+        """Join each of the ``new`` vertices to its (at most ``neighbours_max``) nearest
+        vertices within ``neighbour_radius_m`` where ``local_map`` admits the edge (an
+        edge leaving its crop is not admitted), as gbplanner joins a vertex it adds to
+        its global graph (``Rrg::expandGraphEdges``): the graph is a roadmap of the
+        explored space, not the robot's track."""
         cfg = self.config
-        if len(new) == 0 or len(self._positions) < 2:
+        if len(new) == 0:
             return
         pts = self.positions
         k = min(cfg.neighbours_max + 1, len(pts))
         d, near = self._kdtree().query(pts[new], k=k, distance_upper_bound=cfg.neighbour_radius_m)
-        d, near = d.reshape(len(new), k), near.reshape(len(new), k)
-        u = np.repeat(new, k)
-        v, d = near.reshape(-1), d.reshape(-1)
-        # Each pair once: an old vertex, or a new one with a smaller id; not already joined.
-        keep = np.isfinite(d) & (d > cfg.edge_length_min_m) & (~np.isin(v, new) | (v < u))
-        pairs = [(int(a), int(b)) for a, b in zip(u[keep], v[keep]) if not self.graph.has_edge(a, b)]
+        u, v = np.repeat(new, k), near.reshape(-1)
+        keep = np.isfinite(d.reshape(-1)) & (u != v)
+        # Each pair once, whichever of its two ends listed the other; not already joined.
+        pairs = {(min(a, b), max(a, b)) for a, b in zip(u[keep].tolist(), v[keep].tolist())}
+        pairs = sorted(p for p in pairs if not self.graph.has_edge(*p))
         if not pairs:
             return
         a, b = np.asarray(pairs).T
@@ -339,10 +339,10 @@ class GlobalPlanner:
         self, grid: Grid, position: np.ndarray, endurance_remaining_s: float | None = None
     ) -> GlobalPlanResult:
         """A path to the best frontier: gain / (path length + ``frontier_distance_offset_m``),
-        among frontiers from which the robot can still get home within its endurance
-        (along the graph, or, where an edge found blocked cut a frontier off from home on
-        the graph, in a straight line, as :meth:`homing_check` estimates it: before, such
-        frontiers were all "not reachable within the endurance" and the robot gave up)."""
+        among frontiers from which the robot can still get home within its endurance:
+        along the graph, or, where an edge found blocked cut a frontier off from home on
+        the graph, in a straight line (an optimistic estimate, the one
+        :meth:`homing_check` makes in that case too)."""
         cfg = self.config
         self.update_frontiers(grid)
         if not self.frontiers:

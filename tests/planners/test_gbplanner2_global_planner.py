@@ -153,17 +153,18 @@ def test_new_vertices_are_joined_to_their_neighbours(tunnel):
     out = home + np.array([[x, 0.8, 0] for x in np.arange(1.0, 30.0, 1.5)])
     back = home + np.array([[x, -0.8, 0] for x in np.arange(28.5, 1.0, -1.5)])
 
-    def across(grid):
-        """Graph distance between the two tracks 20 m in, after driving out and back."""
+    def across(grid, paths=(out, back)):
+        """Graph distance between the two tracks 20 m in, after driving ``paths``."""
         gp = GlobalPlanner(CFG, home)
         lm = None if grid is None else LocalMap(grid, a - 2, a + np.array([42.0, 2, 2]), CFG)
-        for path in (out, back):
+        for path in paths:
             gp.add_local_result(LocalPlanResult(path=path, gain=1e3, reason="", diagnostics=PlanDiagnostics(),
                                                 root=path[0], local_map=lm))
         u, v = (int(np.argmin(np.linalg.norm(gp.positions - (home + [20.0, y, 0]), axis=1))) for y in (0.8, -0.8))
         return nx.shortest_path_length(gp.graph, u, v, weight="weight")
 
     assert across(g) < 2.5
+    assert across(g, paths=(np.concatenate([out, back]),)) < 2.5  # new vertices joined to each other
     assert across(None) > 15.0  # no map to check edges on: the track only
     # rock along the tunnel's axis beyond 2 m: the tracks are not joined through it
     occ = g.occupancy.copy()
