@@ -296,11 +296,16 @@ class GlobalPlanner:
             reason = ""
         else:
             # No way home on the graph: the straight line is the most optimistic estimate.
-            length = float(np.linalg.norm(np.asarray(position, float) - self.home))
+            length = self._straight_home_m(position)
             reason = f"no path home on the global graph ({home.reason}); straight-line estimate"
         t_home = length / cfg.speed_mps
         required = endurance_remaining_s <= t_home + reserve
         return HomingCheck(required, length, t_home, reserve, float(endurance_remaining_s), reason, home)
+
+    def _straight_home_m(self, position: np.ndarray) -> float:
+        """The straight line home: the optimistic length of the way home where the graph
+        has none."""
+        return float(np.linalg.norm(np.asarray(position, float) - self.home))
 
     def plan_home(self, grid: Grid, position: np.ndarray) -> GlobalPlanResult:
         """The way home along the global graph."""
@@ -357,8 +362,7 @@ class GlobalPlanner:
             if v not in dist:
                 continue
             if endurance_remaining_s is not None:
-                # No way home on the graph: the straight line, as homing_check estimates it.
-                back = home_dist.get(v, float(np.linalg.norm(f.position - self.home)))
+                back = home_dist[v] if v in home_dist else self._straight_home_m(f.position)
                 need = (dist[v] + back) / cfg.speed_mps + cfg.homing_margin_s
                 if need > endurance_remaining_s:
                     continue
