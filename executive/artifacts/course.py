@@ -15,6 +15,7 @@ from ...sim.artifact_sensors import ArtifactSensors
 from ...sim.artifacts import Artifact
 from ...sim.referee import Referee, Score
 from ...skills.artifacts.base_station import REFEREE
+from ..worlds.height_bands import ALL_HEIGHTS, HeightBand
 from .figures import artifact_figures
 from .plots import draw_artifacts, plot_scores
 from .sensors import sensor_spec
@@ -69,8 +70,8 @@ class NoArtifacts:
         """The report's ``artifacts`` section (none)."""
         return {}
 
-    def draw(self, ax: "Axes", mission: "Mission") -> None:
-        """Mark the artifacts on the top-down map (none)."""
+    def draw(self, ax: "Axes", mission: "Mission", band: HeightBand = ALL_HEIGHTS) -> None:
+        """Mark the artifacts at ``band``'s heights on the top-down map (none)."""
 
     def write_plots(self, mission: "Mission", out: Path) -> list[Path]:
         """Write the artifact pictures into ``out`` (none); the files written."""
@@ -118,8 +119,8 @@ class ArtifactCourse(NoArtifacts):
     def figures(self, mission: "Mission") -> dict[str, Any]:
         return artifact_figures(mission, self)
 
-    def draw(self, ax: "Axes", mission: "Mission") -> None:
-        draw_artifacts(ax, mission, self)
+    def draw(self, ax: "Axes", mission: "Mission", band: HeightBand = ALL_HEIGHTS) -> None:
+        draw_artifacts(ax, mission, self, band)
 
     def write_plots(self, mission: "Mission", out: Path) -> list[Path]:
         plot_scores(mission, self, out / "scored.png")

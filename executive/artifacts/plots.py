@@ -11,6 +11,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from ..worlds.height_bands import ALL_HEIGHTS, HeightBand  # noqa: E402
 from .view import CourseView  # noqa: E402
 
 if TYPE_CHECKING:
@@ -44,12 +45,12 @@ def artifact_outcomes(mission: "Mission", course: CourseView) -> dict[str, str]:
     return out
 
 
-def draw_artifacts(ax: "Axes", mission: "Mission", course: CourseView) -> None:
-    """Mark each artifact on the top-down map by its outcome, with its class, and
-    every submission that scored nothing with a small red cross."""
+def draw_artifacts(ax: "Axes", mission: "Mission", course: CourseView, band: HeightBand = ALL_HEIGHTS) -> None:
+    """Mark each artifact at ``band``'s heights on the top-down map by its outcome, with its
+    class, and every submission there that scored nothing with a small red cross."""
     outcomes = artifact_outcomes(mission, course)
     for outcome, (marker, colour, label) in OUTCOMES.items():
-        mine = [a for a in course.artifacts if outcomes[a.name] == outcome]
+        mine = [a for a in course.artifacts if outcomes[a.name] == outcome and band.holds(a.position).all()]
         if not mine:
             continue
         pts = np.array([a.position for a in mine])
@@ -59,6 +60,7 @@ def draw_artifacts(ax: "Axes", mission: "Mission", course: CourseView) -> None:
             ax.annotate(a.artifact_class.replace("_", " "), a.position[:2], fontsize=6,
                         xytext=(4, 4), textcoords="offset points", zorder=6)
     wrong = np.array([s.position for s in course.referee.scores if s.counted and not s.scored]).reshape(-1, 3)
+    wrong = wrong[band.holds(wrong)]
     if len(wrong):
         ax.scatter(wrong[:, 0], wrong[:, 1], marker="x", s=20, c="red", zorder=5,
                    label=f"report that scored nothing ({len(wrong)})")

@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING, Any, ClassVar
 from py_trees.common import Status
 
 from ...skills.base import Param
+from ..worlds.height_bands import ALL_HEIGHTS, HeightBand
 
 if TYPE_CHECKING:
     from ..agent import Agent
@@ -96,8 +97,9 @@ class TeamStrategy(ABC):
         voxels = mission.backend.map_undelivered(name)
         return {} if voxels is None else {"map_voxels_undelivered": voxels}
 
-    def draw(self, ax: Any, mission: "Mission") -> None:
-        """Draw what the strategy decided on the top-down ``map.png`` (matplotlib axes)."""
+    def draw(self, ax: Any, mission: "Mission", band: HeightBand = ALL_HEIGHTS) -> None:
+        """Draw what the strategy decided on the top-down ``map.png`` (matplotlib axes): what
+        lies at the heights of ``band`` (one level's view on a world of several)."""
 
     def wall_clock_figures(self, mission: "Mission") -> dict[str, Any]:
         """This strategy's figures that depend on the wall clock (``WALL_CLOCK_FIELDS``)."""

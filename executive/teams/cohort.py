@@ -20,6 +20,7 @@ from ...skills.base import Param, short_repr
 from ...skills import cohort as cohort_skills
 from ...skills.cohort.hub import HOME_SERVICE, HUB_SERVICE, PARAMS_SERVICE
 from ..errors import DelveError
+from ..worlds.height_bands import ALL_HEIGHTS, HeightBand
 from ..worlds import BASE
 from .base import TeamStrategy
 
@@ -129,9 +130,9 @@ class Cohort(TeamStrategy):
     def figures(self, mission: "Mission") -> dict[str, Any]:
         return {"cohort": cohort_figures(mission.state.events, list(mission.robots), self.hub(mission))}
 
-    def draw(self, ax: Any, mission: "Mission") -> None:
+    def draw(self, ax: Any, mission: "Mission", band: HeightBand = ALL_HEIGHTS) -> None:
         """On ``map.png``: the hub's frontier clusters at the end, every box it gave
-        and the points where robots spoke to the hub."""
+        and the points where robots spoke to the hub (those at ``band``'s heights)."""
         hub = self.hub(mission)
         if hub is not None:
             world = mission.world
@@ -139,7 +140,7 @@ class Cohort(TeamStrategy):
             hi = np.asarray(getattr(world, "bounds_max", (np.inf,) * 3), float)[:2]
             boxes = targets = 0
             for rec in hub.assignments:
-                if rec.result.box_min is None:
+                if rec.result.box_min is None or not band.holds(rec.result.frontier).all():
                     continue
                 (x0, y0), (x1, y1) = rec.result.box_min[:2], rec.result.box_max[:2]
                 # A box clipped to the world across (the paper's 360 m on our worlds) restricts
@@ -152,10 +153,12 @@ class Cohort(TeamStrategy):
                         label=None if targets else "COHORT target")
                 targets += 1
             c = hub.frontier_centroids
+            c = c[band.holds(c)]
             if len(c):
                 ax.plot(c[:, 0], c[:, 1], "D", ms=4, mfc="none", color="darkorange", label="hub frontiers (end)")
         calls = np.array([e["position"] for e in mission.state.events if e["event"] == "cohort_call"
                           and e.get("reached")]).reshape(-1, 3)
+        calls = calls[band.holds(calls)]
         if len(calls):
             ax.plot(calls[:, 0], calls[:, 1], "x", ms=5, color="black", label="call to the hub (link)")
 

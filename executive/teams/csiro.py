@@ -24,6 +24,7 @@ from ...skills.base import Param, short_repr
 from ...skills.csiro import BASE_SERVICE, CONFIG_SERVICE, STATE_SERVICE, CsiroConfig
 from ...skills.csiro.state import EXPLORE_SYNC_S
 from ..worlds import BASE
+from ..worlds.height_bands import ALL_HEIGHTS, HeightBand
 from .base import TeamStrategy
 
 if TYPE_CHECKING:
@@ -126,28 +127,31 @@ class Csiro(TeamStrategy):
         agent = mission.agents.get(BASE)
         return None if agent is None else agent.ctx.services.get(BASE_SERVICE)
 
-    def draw(self, ax: Any, mission: "Mission") -> None:
+    def draw(self, ax: Any, mission: "Mission", band: HeightBand = ALL_HEIGHTS) -> None:
         """On ``map.png``: the team's topometric map (grey: the trajectory edges; the observer-planning
         edges, which join nodes across junctions, are counted in the legend, not drawn), the frontiers
         current at the end (magenta dots at their means; where a mean lies off the world's free space,
         the mean of a patch of wall or roof, a ground robot's frontier is drawn at its observer and a
         flying robot's not at all), the goals that failed (red crosses, at the goal), where syncs
-        happened and the regions robots went back to."""
+        happened and the regions robots went back to; those at ``band``'s heights."""
         states = {name: mission.agents[name].ctx.services.get(STATE_SERVICE) for name in mission.robots}
         states = {name: st for name, st in states.items() if st is not None}
-        _draw_topometric(ax, [st.topometric for st in states.values()])
-        _draw_frontiers(ax, mission, states)
+        _draw_topometric(ax, [st.topometric for st in states.values()], band)
+        _draw_frontiers(ax, mission, states, band)
         events = mission.state.events
         failed = np.array(failed_goals(events)).reshape(-1, 3)
+        failed = failed[band.holds(failed)]
         if len(failed):
             ax.plot(failed[:, 0], failed[:, 1], "x", ms=4, mew=0.8, color="firebrick", zorder=4,
                     label=f"frontier goals that failed ({len(failed)})")
         syncs = np.array([e["position"] for e in events if e["event"] == "csiro_sync"]).reshape(-1, 3)
+        syncs = syncs[band.holds(syncs)]
         if len(syncs):
             ax.plot(syncs[:, 0], syncs[:, 1], "s", ms=6, mfc="none", color="blue", label="explore-sync uplink",
                     zorder=5)
         regions = np.array([e["region"] for e in events
                             if e["event"] == "csiro_region_reached"]).reshape(-1, 3)
+        regions = regions[band.holds(regions)]
         if len(regions):
             ax.plot(regions[:, 0], regions[:, 1], "*", ms=8, color="orange", label="region returned to", zorder=5)
 
@@ -165,8 +169,9 @@ def failed_goals(events: list[dict[str, Any]]) -> list[list[float]]:
     return out
 
 
-def _draw_topometric(ax: Any, maps: list[Any]) -> None:
-    """The union of the robots' topometric maps: trajectory edges (a robot's node k to k + 1)."""
+def _draw_topometric(ax: Any, maps: list[Any], band: HeightBand) -> None:
+    """The union of the robots' topometric maps: trajectory edges (a robot's node k to k + 1)
+    that start at ``band``'s heights."""
     edges, positions = set(), {}
     for m in maps:
         for a, b in m.graph.edges:
@@ -174,19 +179,21 @@ def _draw_topometric(ax: Any, maps: list[Any]) -> None:
                 edges.add((min(a, b), max(a, b)))
                 positions[a], positions[b] = m.position(a), m.position(b)
     along = sorted(e for e in edges if e[0][0] == e[1][0] and abs(e[0][1] - e[1][1]) == 1)
+    planning = len(edges) - len(along)
+    along = [e for e in along if band.holds(positions[e[0]]).all()]
     if not along:
         return
     segments = np.array([[positions[a][:2], positions[b][:2]] for a, b in along])
     xs = np.column_stack([segments[:, :, 0], np.full(len(segments), np.nan)]).reshape(-1)
     ys = np.column_stack([segments[:, :, 1], np.full(len(segments), np.nan)]).reshape(-1)
     ax.plot(xs, ys, "-", lw=0.6, color="0.45", zorder=1,
-            label=f"topometric map ({len(edges) - len(along)} observer-planning edges not drawn)")
+            label=f"topometric map ({planning} observer-planning edges not drawn)")
 
 
-def _draw_frontiers(ax: Any, mission: "Mission", states: dict[str, Any]) -> None:
+def _draw_frontiers(ax: Any, mission: "Mission", states: dict[str, Any], band: HeightBand) -> None:
     """Every robot's frontiers at the end (see :meth:`Csiro.draw`)."""
     is_free = getattr(mission.world, "is_free", None)
-    means, observers, hidden = [], [], 0
+    means, observers, hidden_means = [], [], []
     for name, st in states.items():
         aerial = mission.robots[name].mobility.aerial
         for f in st.frontiers.frontiers:
@@ -195,10 +202,12 @@ def _draw_frontiers(ax: Any, mission: "Mission", states: dict[str, Any]) -> None
                 continue
             summary = None if aerial else st.summaries.get((name, f.id))
             if summary is None:
-                hidden += 1
+                hidden_means.append(f.mean)
             else:
                 observers.append(summary.observer)
     means, observers = np.array(means).reshape(-1, 3), np.array(observers).reshape(-1, 3)
+    means, observers = means[band.holds(means)], observers[band.holds(observers)]
+    hidden = int(band.holds(np.array(hidden_means).reshape(-1, 3)).sum())
     if len(means):
         ax.plot(means[:, 0], means[:, 1], "o", ms=3, color="magenta", zorder=4,
                 label=f"frontiers at the end, at their means ({len(means)})")

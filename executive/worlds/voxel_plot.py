@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import matplotlib
 
@@ -14,6 +14,7 @@ from scipy.ndimage import binary_dilation, find_objects, label, maximum_filter1d
 from ...planners.frontier import FRONTIER_DEPTH, frontier_voxels  # noqa: E402
 from ...planners.navgraph import FACES, Voxels  # noqa: E402
 from ...planners.occupancy import OCCUPIED, UNKNOWN, Grid  # noqa: E402
+from .height_bands import ALL_HEIGHTS, HeightBand, height_bands  # noqa: E402
 
 if TYPE_CHECKING:
     from ..runner import Mission
@@ -84,71 +85,105 @@ def long_edges(columns: np.ndarray, voxel_size_m: float, min_length_m: float = M
     return keep[labels]
 
 
-def frontiers_left(mission: "Mission") -> np.ndarray:
-    """(N, 2) world x, y of the columns drawn as frontiers left: each robot's frontier voxels
-    that open onto ground the team did not see (:func:`open_frontiers`), seen from above, in
-    edges of at least :data:`MIN_EDGE_M` (:func:`long_edges`)."""
+def frontiers_left(mission: "Mission", bands: list[HeightBand] | None = None) -> list[np.ndarray]:
+    """Per height band (``bands``, default one of every height), (N, 2) world x, y of the
+    columns drawn as frontiers left: each robot's frontier voxels in the band that open onto
+    ground the team did not see (:func:`open_frontiers`), seen from above, in edges of at
+    least :data:`MIN_EDGE_M` (:func:`long_edges`)."""
+    bands = bands or [ALL_HEIGHTS]
     maps = [robot.onboard_map for robot in mission.robots.values()]
     if not maps:
-        return np.zeros((0, 2))
+        return [np.zeros((0, 2)) for _ in bands]
     seen = seen_ground([m.occupancy for m in maps], maps[0].voxel_size_m)
     rock = np.zeros(maps[0].shape, dtype=bool)
     for m in maps:
         rock |= m.occupancy == OCCUPIED
-    columns = np.zeros(maps[0].shape[:2], dtype=bool)
-    for m in maps:
-        grid = Grid(m.occupancy, m.origin, m.voxel_size_m)
-        i, j, _ = np.unravel_index(open_frontiers(grid, frontier_voxels(grid), seen, rock), grid.shape)
-        columns[i, j] = True
-    ij = np.argwhere(long_edges(columns, maps[0].voxel_size_m))
-    return np.asarray(maps[0].origin)[:2] + (ij + 0.5) * maps[0].voxel_size_m
+    opening = np.concatenate([open_frontiers(grid, frontier_voxels(grid), seen, rock)
+                              for grid in (Grid(m.occupancy, m.origin, m.voxel_size_m) for m in maps)])
+    i, j, k = np.unravel_index(opening, maps[0].shape)
+    vs, origin = maps[0].voxel_size_m, np.asarray(maps[0].origin, float)
+    height = origin[2] + (k + 0.5) * vs
+    out = []
+    for band in bands:
+        columns = np.zeros(maps[0].shape[:2], dtype=bool)
+        inside = band.holds_heights(height)
+        columns[i[inside], j[inside]] = True
+        out.append(origin[:2] + (np.argwhere(long_edges(columns, vs)) + 0.5) * vs)
+    return out
 
 
 def plot_voxel_map(mission: "Mission", truth_voxels: np.ndarray, path: Path) -> None:
     """Top-down map: free space, what the team saw, walls, paths (flying robots' dashed, on
     top), the frontiers left at the end that open onto unseen ground (:func:`frontiers_left`),
-    radio links (under the paths)."""
+    radio links (under the paths). A world of several levels (:func:`height_bands`) gets one
+    top view per level, the lowest first, each drawing only what lies at its heights."""
     world = mission.world
-    extent = (world.origin[0], world.origin[0] + world.free.shape[0] * world.voxel_size_m,
-              world.origin[1], world.origin[1] + world.free.shape[1] * world.voxel_size_m)
-    fig, ax = plt.subplots(figsize=(9, 9 * (extent[3] - extent[2]) / max(extent[1] - extent[0], 1e-6) + 0.8))
     truth = np.zeros(world.free.size, dtype=bool)
     truth[truth_voxels] = True
+    truth = truth.reshape(world.free.shape)
+    bands = height_bands(truth, float(world.origin[2]), world.voxel_size_m)
+    extent = (world.origin[0], world.origin[0] + world.free.shape[0] * world.voxel_size_m,
+              world.origin[1], world.origin[1] + world.free.shape[1] * world.voxel_size_m)
+    aspect = (extent[3] - extent[2]) / max(extent[1] - extent[0], 1e-6)
+    fig, axes = plt.subplots(len(bands), 1, figsize=(9, (9 * aspect + 0.8) * len(bands)), squeeze=False)
     seen = np.zeros(world.free.shape, dtype=bool)
     walls = np.zeros(world.free.shape, dtype=bool)
     for robot in mission.robots.values():
         seen |= robot.onboard_map.occupancy == 0
         walls |= robot.onboard_map.occupancy == 1
-    img = np.ones(world.free.shape[:2][::-1] + (3,))
-    img[_top_down(truth.reshape(world.free.shape))] = (0.85, 0.85, 0.85)
+    layers = world.origin[2] + (np.arange(world.free.shape[2]) + 0.5) * world.voxel_size_m
+    left = frontiers_left(mission, bands)
+    any_left = any(len(f) for f in left)
+    title = f"{mission.scenario.name}: team coverage {mission.state.samples[-1].team:.0%}"
+    for ax, band, band_left in zip(axes[:, 0], bands, left):
+        at = band.holds_heights(layers)
+        _draw_band(ax, mission, band, extent, (truth[..., at], seen[..., at], walls[..., at]), band_left, any_left)
+        ax.set_xlabel("x (m)")
+        ax.set_ylabel("y (m)")
+        level = f"level {bands.index(band) + 1} of {len(bands)}: {band.label}"
+        ax.set_title(title if len(bands) == 1 else f"{title}\n{level}" if band is bands[0] else level)
+        # Beside the map, not on it: with a team's many entries it hid part of the world.
+        # A level's beside its view: its counts are the level's.
+        ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0, fontsize=7)
+    fig.savefig(path, dpi=110, bbox_inches="tight")
+    plt.close(fig)
+
+
+def _draw_band(ax: Any, mission: "Mission", band: HeightBand, extent: tuple[float, ...],
+               grids: tuple[np.ndarray, np.ndarray, np.ndarray], left: np.ndarray, any_left: bool) -> None:
+    """One top view: the ``grids`` (truth, seen, walls: the voxel layers at the band's
+    heights), and what lies in the band of the paths, frontiers left (``left``), radio
+    links, base station, artifacts and the team strategy's marks."""
+    truth, seen, walls = grids
+    img = np.ones(truth.shape[:2][::-1] + (3,))
+    img[_top_down(truth)] = (0.85, 0.85, 0.85)
     img[_top_down(seen)] = (0.72, 0.84, 0.95)
     img[_top_down(walls) & ~_top_down(seen)] = (0.35, 0.35, 0.35)
     ax.imshow(img, origin="lower", extent=extent, interpolation="nearest")
     colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     for i, (name, robot) in enumerate(mission.robots.items()):
-        trail = robot.traversed_path
+        trail = np.array(robot.traversed_path, float).reshape(-1, 3)
+        trail[~band.holds(trail)] = np.nan   # the path's parts at other heights leave gaps
+        if band is not ALL_HEIGHTS and np.isnan(trail).all():
+            continue
         aerial = robot.mobility.aerial
         # A flying robot's path dashed and above the ground robots' solid ones: where it flew
         # over a ground robot's path, that path shows between its dashes.
         ax.plot(trail[:, 0], trail[:, 1], ls=(0, (4, 2.5)) if aerial else "-", lw=1.3,
                 color=colours[i % len(colours)], zorder=2.2 if aerial else 2.0,
                 label=f"{name} path (flying)" if aerial else f"{name} path")
-    left = frontiers_left(mission)
-    ax.plot(left[:, 0], left[:, 1], ".", ms=2, color="red", zorder=3,
-            label=f"frontiers left: where the seen area opens\nonto unseen ground (edges >= {MIN_EDGE_M:g} m)"
-            if len(left) else "no frontiers left: the seen area nowhere\nopens onto unseen ground")
+    if len(left) or not any_left:
+        ax.plot(left[:, 0], left[:, 1], ".", ms=2, color="red", zorder=3,
+                label=f"frontiers left: where the seen area opens\nonto unseen ground (edges >= {MIN_EDGE_M:g} m)"
+                if len(left) else "no frontiers left: the seen area nowhere\nopens onto unseen ground")
     for i, name in enumerate(mission.robots):
-        pos = np.array([s.positions[name] for s in mission.state.samples])
-        linked = np.array([s.linked[name] for s in mission.state.samples])
+        pos = np.array([s.positions[name] for s in mission.state.samples]).reshape(-1, 3)
+        linked = np.array([s.linked[name] for s in mission.state.samples], dtype=bool) & band.holds(pos)
         ax.plot(pos[linked, 0], pos[linked, 1], "o", ms=3, color="green", zorder=1.9,   # under the paths
                 label="radio link to base" if i == 0 else None)
-    ax.plot(*mission.base_position[:2], "k^", ms=9, label="base station")
-    mission.artifacts.draw(ax, mission)
-    mission.team.draw(ax, mission)
-    ax.set_xlabel("x (m)")
-    ax.set_ylabel("y (m)")
-    ax.set_title(f"{mission.scenario.name}: team coverage {mission.state.samples[-1].team:.0%}")
-    # Beside the map, not on it: with a team's many entries it hid part of the world.
-    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0, fontsize=7)
-    fig.savefig(path, dpi=110, bbox_inches="tight")
-    plt.close(fig)
+    if band.holds(mission.base_position).all():
+        ax.plot(*mission.base_position[:2], "k^", ms=9, label="base station")
+    mission.artifacts.draw(ax, mission, band)
+    mission.team.draw(ax, mission, band)
+    ax.set_xlim(extent[0], extent[1])
+    ax.set_ylim(extent[2], extent[3])

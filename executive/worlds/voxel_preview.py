@@ -15,6 +15,7 @@ from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.patches import Patch  # noqa: E402
 
 from ...sim.world import World  # noqa: E402
+from .height_bands import ALL_HEIGHTS, HeightBand, height_bands  # noqa: E402
 
 if TYPE_CHECKING:
     from ..scenario import Scenario
@@ -33,40 +34,49 @@ MAX_STRETCH = 10
 
 
 def draw_preview(scenario: "Scenario", world: World, starts: list["StartPlacement"], out: Path) -> list[Path]:
-    """Write ``top.png`` (looking down) and ``side.png`` (looking along +y) into ``out``."""
+    """Write ``top.png`` (looking down; one view per level, the lowest first, on a world of
+    several: :func:`height_bands`) and ``side.png`` (looking along +y) into ``out``."""
     out.mkdir(parents=True, exist_ok=True)
     labels, sizes = world.free_regions()
     main = labels == int(np.argmax(sizes)) if sizes.any() else np.zeros(world.shape, bool)
     other = (labels > 0) & ~main
     n_regions = int(np.count_nonzero(sizes))
+    bands = height_bands(world.free, float(world.origin[2]), world.voxel_size_m)
+    layers = world.origin[2] + (np.arange(world.shape[2]) + 0.5) * world.voxel_size_m
     paths = []
     for name, (a, b), flat in (("top", (0, 1), 2), ("side", (0, 2), 1)):
-        img = np.empty((world.shape[a], world.shape[b], 3))
-        img[:] = ROCK_RGB
-        img[other.any(axis=flat)] = OTHER_RGB
-        img[main.any(axis=flat)] = MAIN_RGB
         lo, hi = world.bounds_min, world.bounds_max
         extent = (lo[a], hi[a], lo[b], hi[b])
         w, h = hi[a] - lo[a], hi[b] - lo[b]
         stretch = 1 if name == "top" or h >= FLAT_VIEW * w else min(int(round(FLAT_VIEW * w / h)), MAX_STRETCH)
-        fig, ax = plt.subplots(figsize=_figsize(w, h * stretch))
-        ax.imshow(np.transpose(img, (1, 0, 2)), origin="lower", extent=extent, interpolation="nearest",
-                  aspect=stretch)
-        handles = [Patch(color=MAIN_RGB, label="free space (largest region)"),
-                   Patch(color=ROCK_RGB, label="rock / outside")]
-        if other.any():
-            handles.insert(1, Patch(color=OTHER_RGB, label=f"other free regions ({n_regions - 1})"))
-        if name == "side" and world.source is not None and world.source.ceiling_z is not None:
-            ax.axhline(world.source.ceiling_z, color="0.4", ls="--", lw=1)
-            handles.append(Line2D([], [], color="0.4", ls="--", label="ceiling added"))
-        handles += _draw_starts(ax, world, starts, scenario, (a, b))
-        ax.set_xlabel("x (m)")
-        ax.set_ylabel("y (m)" if name == "top" else "z (m, up)")
-        view = "top view" if name == "top" else "side view (looking along +y" + (
-            f", heights stretched ×{stretch})" if stretch > 1 else ")")
-        ax.set_title(f"{scenario.name}: {view}\nfree {world.free_volume_m3:.0f} m³ in {n_regions} region(s), "
-                     f"voxels of {world.voxel_size_m:g} m", fontsize=10)
-        ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8, frameon=False)
+        views = bands if name == "top" else [ALL_HEIGHTS]
+        fw, fh = _figsize(w, h * stretch)
+        fig, axes = plt.subplots(len(views), 1, figsize=(fw, fh * len(views)), squeeze=False)
+        for ax, band in zip(axes[:, 0], views):
+            at = band.holds_heights(layers)
+            img = np.empty((world.shape[a], world.shape[b], 3))
+            img[:] = ROCK_RGB
+            img[other[..., at].any(axis=flat)] = OTHER_RGB
+            img[main[..., at].any(axis=flat)] = MAIN_RGB
+            ax.imshow(np.transpose(img, (1, 0, 2)), origin="lower", extent=extent, interpolation="nearest",
+                      aspect=stretch)
+            handles = [Patch(color=MAIN_RGB, label="free space (largest region)"),
+                       Patch(color=ROCK_RGB, label="rock / outside")]
+            if other.any():
+                handles.insert(1, Patch(color=OTHER_RGB, label=f"other free regions ({n_regions - 1})"))
+            if name == "side" and world.source is not None and world.source.ceiling_z is not None:
+                ax.axhline(world.source.ceiling_z, color="0.4", ls="--", lw=1)
+                handles.append(Line2D([], [], color="0.4", ls="--", label="ceiling added"))
+            handles += _draw_starts(ax, world, starts, scenario, (a, b), band)
+            ax.set_xlabel("x (m)")
+            ax.set_ylabel("y (m)" if name == "top" else "z (m, up)")
+            view = "top view" if name == "top" else "side view (looking along +y" + (
+                f", heights stretched ×{stretch})" if stretch > 1 else ")")
+            if len(views) > 1:
+                view += f", level {views.index(band) + 1} of {len(views)}: {band.label}"
+            ax.set_title(f"{scenario.name}: {view}\nfree {world.free_volume_m3:.0f} m³ in {n_regions} region(s), "
+                         f"voxels of {world.voxel_size_m:g} m", fontsize=10)
+            ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8, frameon=False)
         fig.tight_layout()
         path = out / f"{name}.png"
         fig.savefig(path, dpi=110, bbox_inches="tight")
@@ -85,9 +95,10 @@ def _figsize(w: float, h: float) -> tuple[float, float]:
 
 
 def _draw_starts(ax, world: World, starts: list["StartPlacement"], scenario: "Scenario",
-                 axes: tuple[int, int]) -> list:
-    """Mark each start (green: stands as given; orange: moved down onto the floor; red
-    cross: an error, with the nearest free floor); the base station as a triangle."""
+                 axes: tuple[int, int], band: HeightBand) -> list:
+    """Mark each start at ``band``'s heights (green: stands as given; orange: moved down onto
+    the floor; red cross: an error, with the nearest free floor); the base station as a
+    triangle."""
     a, b = axes
     seen: dict[str, Line2D] = {}
 
@@ -97,6 +108,8 @@ def _draw_starts(ax, world: World, starts: list["StartPlacement"], scenario: "Sc
 
     for s in starts:
         ld = s.landing
+        if not band.holds(ld.given if ld.problem else ld.start).all():
+            continue
         if ld.problem:
             mark(ld.given, "x", "start that is an error", color="red", mew=2.5)
             floor = world.nearest_floor(ld.given)
@@ -113,6 +126,6 @@ def _draw_starts(ax, world: World, starts: list["StartPlacement"], scenario: "Sc
         else:
             mark(ld.start, "o", "start", color="limegreen", mec="black")
         ax.annotate(s.name, (ld.start[a], ld.start[b]), xytext=(6, 6), textcoords="offset points", fontsize=8)
-    if scenario.base_position is not None:
+    if scenario.base_position is not None and band.holds(scenario.base_position).all():
         mark(np.asarray(scenario.base_position, float), "^", "base station", color="black")
     return list(seen.values())

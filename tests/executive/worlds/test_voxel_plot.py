@@ -44,20 +44,26 @@ def mission_of(robots: dict[str, tuple[np.ndarray, np.ndarray, bool]]) -> Simple
     return SimpleNamespace(world=SimpleNamespace(origin=origin, free=first >= FREE, voxel_size_m=VOXEL),
                            robots=bots, agents={}, state=SimpleNamespace(samples=[sample], events=[]),
                            base_position=np.array([0.5, 2.0, 0.3]), scenario=SimpleNamespace(name="drift"),
-                           artifacts=SimpleNamespace(draw=lambda ax, mission: None),
-                           team=SimpleNamespace(draw=lambda ax, mission: None))
+                           artifacts=SimpleNamespace(draw=lambda ax, mission, band: None),
+                           team=SimpleNamespace(draw=lambda ax, mission, band: None))
 
 
-def drawn(mission, tmp_path, monkeypatch) -> dict[str, matplotlib.lines.Line2D]:
-    """map.png's lines by label (the figure kept open)."""
+def drawn_views(mission, tmp_path, monkeypatch) -> list[dict[str, matplotlib.lines.Line2D]]:
+    """map.png's lines by label, per top view (the figure kept open)."""
     figures, close = [], plt.close
     monkeypatch.setattr(plt, "close", figures.append)
     truth = np.flatnonzero(mission.world.free.reshape(-1))
     plot_voxel_map(mission, truth, tmp_path / "map.png")
     assert (tmp_path / "map.png").stat().st_size > 0
-    lines = {line.get_label(): line for line in figures[0].axes[0].get_lines()}
+    views = [{line.get_label(): line for line in ax.get_lines()} for ax in figures[0].axes]
     close(figures[0])
-    return lines
+    return views
+
+
+def drawn(mission, tmp_path, monkeypatch) -> dict[str, matplotlib.lines.Line2D]:
+    """map.png's lines by label, of a world of one level."""
+    (view,) = drawn_views(mission, tmp_path, monkeypatch)
+    return view
 
 
 PATH = np.array([[0.5, 2.0, 0.6], [7.5, 2.0, 0.6]])
@@ -139,3 +145,28 @@ def test_a_flying_robots_path_is_dashed_above_the_ground_robots_where_they_overl
     assert ground.get_color() != flying.get_color()
     labels = list(lines)                                                    # the paths first in the legend
     assert labels.index("uav path (flying)") < labels.index(next(k for k in labels if "frontiers left" in k))
+
+
+def test_each_level_of_a_two_level_world_has_its_own_top_view_with_what_lies_there(tmp_path, monkeypatch):
+    occ = np.full((70, 24, 100), UNKNOWN, dtype=np.int8)
+    for floor in (1, 79):                                                   # the lower drift, z 0.4-2.4 m,
+        occ[0:60, 4:16, floor:floor + 12] = OCCUPIED                        # the upper one over it, 16-18 m,
+        occ[1:59, 5:15, floor + 1:floor + 11] = FREE                        # seen with their walls
+    occ[27:32, 7:12, 11:80] = OCCUPIED
+    occ[28:31, 8:11, 11:80] = FREE                                          # the shaft between them
+    occ[59, 5:15, 80:90] = FREE                                             # the upper drift goes on, unseen
+    lower = np.array([[0.5, 2.0, 1.0], [11.0, 2.0, 1.0]])
+    climb = np.array([[0.5, 2.0, 1.0], [5.9, 1.9, 1.0], [5.9, 1.9, 17.0], [11.0, 2.0, 17.0]])
+    mission = mission_of({"anymal": (occ, lower, False), "uav": (occ, climb, True)})
+    bands = []
+    mission.team = SimpleNamespace(draw=lambda ax, mission, band: bands.append(band))
+    low, high = drawn_views(mission, tmp_path, monkeypatch)
+    assert len(bands) == 2 and bands[0].hi_m == bands[1].lo_m and 2.4 < bands[0].hi_m < 16.0
+    assert "base station" in low and "base station" not in high
+    assert np.allclose(low["anymal path"].get_xydata(), lower[:, :2]) and "anymal path" not in high
+    flown_low, flown_high = low["uav path (flying)"].get_xydata(), high["uav path (flying)"].get_xydata()
+    assert np.allclose(flown_low[:2], climb[:2, :2]) and np.isnan(flown_low[2:]).all()  # below: up to the shaft
+    assert np.isnan(flown_high[:2]).all() and np.allclose(flown_high[2:], climb[2:, :2])
+    (label,) = [k for k in high if k.startswith("frontiers left")]         # the upper drift's open end
+    assert np.allclose(high[label].get_xdata(), 59.5 * VOXEL)
+    assert not [k for k in low if "frontiers left" in k]                 # nothing open below; not "none left"
