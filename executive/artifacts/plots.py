@@ -59,8 +59,7 @@ def draw_artifacts(ax: "Axes", mission: "Mission", course: CourseView, band: Hei
         for a in mine:
             ax.annotate(a.artifact_class.replace("_", " "), a.position[:2], fontsize=6,
                         xytext=(4, 4), textcoords="offset points", zorder=6)
-    wrong = np.array([s.position for s in course.referee.scores if s.counted and not s.scored]).reshape(-1, 3)
-    wrong = wrong[band.holds(wrong)]
+    wrong = band.within(np.array([s.position for s in course.referee.scores if s.counted and not s.scored]))
     if len(wrong):
         ax.scatter(wrong[:, 0], wrong[:, 1], marker="x", s=20, c="red", zorder=5,
                    label=f"report that scored nothing ({len(wrong)})")

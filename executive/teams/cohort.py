@@ -152,13 +152,11 @@ class Cohort(TeamStrategy):
                 ax.plot(*rec.result.frontier[:2], "*", ms=8, color="purple",
                         label=None if targets else "COHORT target")
                 targets += 1
-            c = hub.frontier_centroids
-            c = c[band.holds(c)]
+            c = band.within(hub.frontier_centroids)
             if len(c):
                 ax.plot(c[:, 0], c[:, 1], "D", ms=4, mfc="none", color="darkorange", label="hub frontiers (end)")
-        calls = np.array([e["position"] for e in mission.state.events if e["event"] == "cohort_call"
-                          and e.get("reached")]).reshape(-1, 3)
-        calls = calls[band.holds(calls)]
+        calls = band.within(np.array([e["position"] for e in mission.state.events if e["event"] == "cohort_call"
+                                      and e.get("reached")]))
         if len(calls):
             ax.plot(calls[:, 0], calls[:, 1], "x", ms=5, color="black", label="call to the hub (link)")
 

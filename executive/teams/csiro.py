@@ -139,19 +139,15 @@ class Csiro(TeamStrategy):
         _draw_topometric(ax, [st.topometric for st in states.values()], band)
         _draw_frontiers(ax, mission, states, band)
         events = mission.state.events
-        failed = np.array(failed_goals(events)).reshape(-1, 3)
-        failed = failed[band.holds(failed)]
+        failed = band.within(np.array(failed_goals(events)))
         if len(failed):
             ax.plot(failed[:, 0], failed[:, 1], "x", ms=4, mew=0.8, color="firebrick", zorder=4,
                     label=f"frontier goals that failed ({len(failed)})")
-        syncs = np.array([e["position"] for e in events if e["event"] == "csiro_sync"]).reshape(-1, 3)
-        syncs = syncs[band.holds(syncs)]
+        syncs = band.within(np.array([e["position"] for e in events if e["event"] == "csiro_sync"]))
         if len(syncs):
             ax.plot(syncs[:, 0], syncs[:, 1], "s", ms=6, mfc="none", color="blue", label="explore-sync uplink",
                     zorder=5)
-        regions = np.array([e["region"] for e in events
-                            if e["event"] == "csiro_region_reached"]).reshape(-1, 3)
-        regions = regions[band.holds(regions)]
+        regions = band.within(np.array([e["region"] for e in events if e["event"] == "csiro_region_reached"]))
         if len(regions):
             ax.plot(regions[:, 0], regions[:, 1], "*", ms=8, color="orange", label="region returned to", zorder=5)
 
@@ -171,16 +167,16 @@ def failed_goals(events: list[dict[str, Any]]) -> list[list[float]]:
 
 def _draw_topometric(ax: Any, maps: list[Any], band: HeightBand) -> None:
     """The union of the robots' topometric maps: trajectory edges (a robot's node k to k + 1)
-    that start at ``band``'s heights."""
+    with both ends at ``band``'s heights."""
     edges, positions = set(), {}
     for m in maps:
         for a, b in m.graph.edges:
             if a[0] != "frontier" and b[0] != "frontier":
                 edges.add((min(a, b), max(a, b)))
                 positions[a], positions[b] = m.position(a), m.position(b)
-    along = sorted(e for e in edges if e[0][0] == e[1][0] and abs(e[0][1] - e[1][1]) == 1)
-    planning = len(edges) - len(along)
-    along = [e for e in along if band.holds(positions[e[0]]).all()]
+    here = [e for e in edges if band.holds(np.array([positions[e[0]], positions[e[1]]])).all()]
+    along = sorted(e for e in here if e[0][0] == e[1][0] and abs(e[0][1] - e[1][1]) == 1)
+    planning = len(here) - len(along)
     if not along:
         return
     segments = np.array([[positions[a][:2], positions[b][:2]] for a, b in along])
@@ -205,9 +201,8 @@ def _draw_frontiers(ax: Any, mission: "Mission", states: dict[str, Any], band: H
                 hidden_means.append(f.mean)
             else:
                 observers.append(summary.observer)
-    means, observers = np.array(means).reshape(-1, 3), np.array(observers).reshape(-1, 3)
-    means, observers = means[band.holds(means)], observers[band.holds(observers)]
-    hidden = int(band.holds(np.array(hidden_means).reshape(-1, 3)).sum())
+    means, observers = band.within(np.array(means)), band.within(np.array(observers))
+    hidden = len(band.within(np.array(hidden_means)))
     if len(means):
         ax.plot(means[:, 0], means[:, 1], "o", ms=3, color="magenta", zorder=4,
                 label=f"frontiers at the end, at their means ({len(means)})")

@@ -34,6 +34,8 @@ MIN_EDGE_M = 1.0
 #: Columns beyond a frontier voxel that must be unseen for it to open onto unseen ground:
 #: the explorers' :data:`~delve.planners.frontier.FRONTIER_DEPTH` and two more.
 OPEN_STRIP = FRONTIER_DEPTH + 2
+#: The picture's height (inches) that views of several levels, one under the other, keep to.
+MAX_HEIGHT_IN = 60.0
 
 
 def seen_ground(maps: list[np.ndarray], voxel_size_m: float, band_m: float = SEEN_BAND_M) -> np.ndarray:
@@ -115,8 +117,9 @@ def frontiers_left(mission: "Mission", bands: list[HeightBand] | None = None) ->
 def plot_voxel_map(mission: "Mission", truth_voxels: np.ndarray, path: Path) -> None:
     """Top-down map: free space, what the team saw, walls, paths (flying robots' dashed, on
     top), the frontiers left at the end that open onto unseen ground (:func:`frontiers_left`),
-    radio links (under the paths). A world of several levels (:func:`height_bands`) gets one
-    top view per level, the lowest first, each drawing only what lies at its heights."""
+    radio links (under the paths). A world of several levels (:func:`height_bands` of the
+    reachable free space, ``truth_voxels``) gets one top view per level, the lowest first,
+    each drawing only what lies at its heights."""
     world = mission.world
     truth = np.zeros(world.free.size, dtype=bool)
     truth[truth_voxels] = True
@@ -125,23 +128,28 @@ def plot_voxel_map(mission: "Mission", truth_voxels: np.ndarray, path: Path) -> 
     extent = (world.origin[0], world.origin[0] + world.free.shape[0] * world.voxel_size_m,
               world.origin[1], world.origin[1] + world.free.shape[1] * world.voxel_size_m)
     aspect = (extent[3] - extent[2]) / max(extent[1] - extent[0], 1e-6)
-    fig, axes = plt.subplots(len(bands), 1, figsize=(9, (9 * aspect + 0.8) * len(bands)), squeeze=False)
+    # Narrower views when several would make the picture taller than MAX_HEIGHT_IN.
+    width = min(9.0, MAX_HEIGHT_IN / len(bands) / max(aspect, 1e-6))
+    fig, axes = plt.subplots(len(bands), 1, figsize=(width, (width * aspect + 0.8) * len(bands)), squeeze=False)
     seen = np.zeros(world.free.shape, dtype=bool)
     walls = np.zeros(world.free.shape, dtype=bool)
     for robot in mission.robots.values():
         seen |= robot.onboard_map.occupancy == 0
         walls |= robot.onboard_map.occupancy == 1
     layers = world.origin[2] + (np.arange(world.free.shape[2]) + 0.5) * world.voxel_size_m
-    left = frontiers_left(mission, bands)
-    any_left = any(len(f) for f in left)
     title = f"{mission.scenario.name}: team coverage {mission.state.samples[-1].team:.0%}"
-    for ax, band, band_left in zip(axes[:, 0], bands, left):
+    for k, (ax, band, left) in enumerate(zip(axes[:, 0], bands, frontiers_left(mission, bands))):
         at = band.holds_heights(layers)
-        _draw_band(ax, mission, band, extent, (truth[..., at], seen[..., at], walls[..., at]), band_left, any_left)
+        _draw_band(ax, mission, band, (truth[..., at], seen[..., at], walls[..., at]), extent, left)
         ax.set_xlabel("x (m)")
         ax.set_ylabel("y (m)")
-        level = f"level {bands.index(band) + 1} of {len(bands)}: {band.label}"
-        ax.set_title(title if len(bands) == 1 else f"{title}\n{level}" if band is bands[0] else level)
+        if len(bands) > 1:
+            level = f"level {k + 1} of {len(bands)}: {band.label}"
+            ax.set_title(f"{title}\n{level}" if k == 0 else level)
+            ax.set_xlim(extent[0], extent[1])   # the same frame in every view
+            ax.set_ylim(extent[2], extent[3])
+        else:
+            ax.set_title(title)
         # Beside the map, not on it: with a team's many entries it hid part of the world.
         # A level's beside its view: its counts are the level's.
         ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0, fontsize=7)
@@ -149,8 +157,8 @@ def plot_voxel_map(mission: "Mission", truth_voxels: np.ndarray, path: Path) -> 
     plt.close(fig)
 
 
-def _draw_band(ax: Any, mission: "Mission", band: HeightBand, extent: tuple[float, ...],
-               grids: tuple[np.ndarray, np.ndarray, np.ndarray], left: np.ndarray, any_left: bool) -> None:
+def _draw_band(ax: Any, mission: "Mission", band: HeightBand, grids: tuple[np.ndarray, np.ndarray, np.ndarray],
+               extent: tuple[float, ...], left: np.ndarray) -> None:
     """One top view: the ``grids`` (truth, seen, walls: the voxel layers at the band's
     heights), and what lies in the band of the paths, frontiers left (``left``), radio
     links, base station, artifacts and the team strategy's marks."""
@@ -163,27 +171,27 @@ def _draw_band(ax: Any, mission: "Mission", band: HeightBand, extent: tuple[floa
     colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     for i, (name, robot) in enumerate(mission.robots.items()):
         trail = np.array(robot.traversed_path, float).reshape(-1, 3)
-        trail[~band.holds(trail)] = np.nan   # the path's parts at other heights leave gaps
-        if band is not ALL_HEIGHTS and np.isnan(trail).all():
-            continue
+        inside = band.holds(trail)
+        if band is not ALL_HEIGHTS and inside.sum() < 2:
+            continue   # no line of it at these heights
+        trail[~inside] = np.nan   # the path's parts at other heights leave gaps
         aerial = robot.mobility.aerial
         # A flying robot's path dashed and above the ground robots' solid ones: where it flew
         # over a ground robot's path, that path shows between its dashes.
         ax.plot(trail[:, 0], trail[:, 1], ls=(0, (4, 2.5)) if aerial else "-", lw=1.3,
                 color=colours[i % len(colours)], zorder=2.2 if aerial else 2.0,
                 label=f"{name} path (flying)" if aerial else f"{name} path")
-    if len(left) or not any_left:
-        ax.plot(left[:, 0], left[:, 1], ".", ms=2, color="red", zorder=3,
-                label=f"frontiers left: where the seen area opens\nonto unseen ground (edges >= {MIN_EDGE_M:g} m)"
-                if len(left) else "no frontiers left: the seen area nowhere\nopens onto unseen ground")
-    for i, name in enumerate(mission.robots):
-        pos = np.array([s.positions[name] for s in mission.state.samples]).reshape(-1, 3)
-        linked = np.array([s.linked[name] for s in mission.state.samples], dtype=bool) & band.holds(pos)
-        ax.plot(pos[linked, 0], pos[linked, 1], "o", ms=3, color="green", zorder=1.9,   # under the paths
-                label="radio link to base" if i == 0 else None)
+    ax.plot(left[:, 0], left[:, 1], ".", ms=2, color="red", zorder=3,
+            label=f"frontiers left: where the seen area opens\nonto unseen ground (edges >= {MIN_EDGE_M:g} m)"
+            if len(left) else "no frontiers left: the seen area nowhere\nopens onto unseen ground")
+    links = [band.within(np.array([s.positions[name] for s in mission.state.samples if s.linked[name]]))
+             for name in mission.robots]
+    # Labelled once: on the first robot with links here (robot 0 on a world of one level).
+    first = next((i for i, p in enumerate(links) if len(p)), 0 if band is ALL_HEIGHTS else None)
+    for i, pos in enumerate(links):
+        ax.plot(pos[:, 0], pos[:, 1], "o", ms=3, color="green", zorder=1.9,   # under the paths
+                label="radio link to base" if i == first else None)
     if band.holds(mission.base_position).all():
         ax.plot(*mission.base_position[:2], "k^", ms=9, label="base station")
     mission.artifacts.draw(ax, mission, band)
     mission.team.draw(ax, mission, band)
-    ax.set_xlim(extent[0], extent[1])
-    ax.set_ylim(extent[2], extent[3])

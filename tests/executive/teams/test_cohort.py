@@ -16,6 +16,7 @@ from delve.executive.runner import Mission  # noqa: E402
 from delve.executive.scenario import load_scenario  # noqa: E402
 from delve.executive.teams import TEAM_STRATEGIES, implied_strategy  # noqa: E402
 from delve.executive.teams.cohort import Cohort, cohort_figures  # noqa: E402
+from delve.executive.worlds.height_bands import ALL_HEIGHTS, HeightBand  # noqa: E402
 from delve.planners.cohort import CohortParams  # noqa: E402
 from delve.skills.cohort import CallHub, MergeSubmaps  # noqa: E402
 
@@ -107,12 +108,12 @@ def test_the_report_counts_per_robot_and_lists_the_assignments():
     assert cohort_figures([], ["r1"], None)["submaps_at_hub"] == 0
 
 
-def drawn_labels(world) -> set[str]:
+def drawn_labels(world, band: HeightBand = ALL_HEIGHTS) -> set[str]:
     mission = SimpleNamespace(agents={"base": SimpleNamespace(ctx=SimpleNamespace(services={"cohort_hub": fake_hub()}))},
                               state=SimpleNamespace(events=[{"event": "cohort_call", "reached": True,
                                                              "position": [1.0, 0.0, 1.0]}]), world=world)
     fig, ax = plt.subplots()
-    Cohort().draw(ax, mission)
+    Cohort().draw(ax, mission, band)
     labels = {line.get_label() for line in ax.get_lines()}
     plt.close(fig)
     return labels
@@ -127,3 +128,10 @@ def test_a_box_spanning_the_world_across_is_not_drawn():
     world = SimpleNamespace(bounds_min=(0.0, -5.0, 0.0), bounds_max=(20.0, 9.0, 10.0))
     labels = drawn_labels(world)
     assert "COHORT box" not in labels and "COHORT target" in labels
+
+
+def test_a_view_of_one_level_draws_only_what_lies_at_its_heights():
+    world = SimpleNamespace(bounds_min=(-50.0, -50.0, -5.0), bounds_max=(50.0, 50.0, 10.0))
+    assert {"COHORT target", "call to the hub (link)"} <= drawn_labels(world, HeightBand(hi_m=5.0))
+    above = drawn_labels(world, HeightBand(lo_m=5.0))                   # the target and the call are at 1 m
+    assert "COHORT target" not in above and "call to the hub (link)" not in above

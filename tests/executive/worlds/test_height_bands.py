@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from delve.executive.worlds.height_bands import ALL_HEIGHTS, HeightBand, height_bands
+from delve.executive.worlds.height_bands import ALL_HEIGHTS, height_bands
 
 VOXEL = 0.2
 
@@ -41,22 +41,27 @@ def test_one_level_is_every_height():
     assert ALL_HEIGHTS.holds(np.array([[0, 0, -1e9], [1, 2, 1e9]])).all()
 
 
-def test_drifts_closer_than_the_gap_are_one_level():
-    gap = round(3.0 / VOXEL)
+def test_drifts_at_least_the_gap_apart_are_two_levels():
+    gap = round(3.0 / VOXEL)                                           # quiet layers of 3 m
+    assert len(height_bands(levels((0, 20, 40), (20 + gap, 40 + gap, 40)), 0.0, VOXEL)) == 2
     assert len(height_bands(levels((0, 20, 40), (20 + gap - 1, 40 + gap, 40)), 0.0, VOXEL)) == 1
-    assert len(height_bands(levels((0, 20, 40), (20 + gap + 1, 40 + gap, 40)), 0.0, VOXEL)) == 2
 
 
-def test_a_small_gallery_above_joins_the_level_below():
-    # 6 x 6 voxels over 20 layers: 2 % of the free volume; busy, but too small for a level.
-    free = levels((0, 20, 40), (70, 90, 6), shaft=(20, 70))
-    assert height_bands(free, 0.0, VOXEL) == [ALL_HEIGHTS]
-    free = levels((0, 20, 40), (70, 90, 14), shaft=(20, 70))           # 12 %: a level of its own
-    assert len(height_bands(free, 0.0, VOXEL)) == 2
+def two_levels_and_a_gallery(x: slice) -> np.ndarray:
+    """Levels at layers 0-19 and 70-89 over x, y 0-40 voxels; a gallery of 13 x 13 voxels
+    (busy: over a tenth of a level's layer) at layers 45-54 over ``x``: 2.6 % of the volume."""
+    free = np.zeros((60, 40, 100), dtype=bool)
+    free[:40, :40, 0:20] = free[:40, :40, 70:90] = True
+    free[x, :13, 45:55] = True
+    return free
 
 
-def test_three_levels_keep_the_larger_neighbours_apart_from_a_small_middle_one():
-    free = levels((0, 20, 40), (45, 50, 10), (80, 100, 40), nz=120)   # the middle one: 1 %
-    bands = height_bands(free, 0.0, VOXEL)
-    assert len(bands) == 2 and bands[0].span_m[1] <= 80 * VOXEL
-    assert isinstance(bands[0], HeightBand)
+def test_a_small_gallery_off_to_one_side_joins_the_nearer_level():
+    bands = height_bands(two_levels_and_a_gallery(slice(45, 58)), 0.0, VOXEL)
+    assert len(bands) == 2 and np.allclose(bands[0].span_m, (0.0, 20 * VOXEL))
+    assert np.allclose(bands[1].span_m, (45 * VOXEL, 90 * VOXEL))             # the upper one, 10 layers nearer
+
+
+def test_a_small_gallery_over_a_level_stays_a_level_of_its_own():
+    bands = height_bands(two_levels_and_a_gallery(slice(0, 13)), 0.0, VOXEL)    # joined, it would hide drifts
+    assert [b.label for b in bands] == ["heights 0 to 4 m", "heights 9 to 11 m", "heights 14 to 18 m"]

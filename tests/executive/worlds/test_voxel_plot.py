@@ -169,4 +169,5 @@ def test_each_level_of_a_two_level_world_has_its_own_top_view_with_what_lies_the
     assert np.isnan(flown_high[:2]).all() and np.allclose(flown_high[2:], climb[2:, :2])
     (label,) = [k for k in high if k.startswith("frontiers left")]         # the upper drift's open end
     assert np.allclose(high[label].get_xdata(), 59.5 * VOXEL)
-    assert not [k for k in low if "frontiers left" in k]                 # nothing open below; not "none left"
+    (label,) = [k for k in low if "frontiers left" in k]                 # nothing open below
+    assert label.startswith("no frontiers left") and len(low[label].get_xdata()) == 0
