@@ -20,7 +20,7 @@ from py_trees.ports import PortInformation
 
 from ..planners.gbplanner2 import Frontier, GBPlanner, GBPlannerConfig, PlanResult
 from ..planners.gbplanner2.link_loss import LinkLoss
-from ..planners.gbplanner2.local_planner import ShrinkingLocalPlanner
+from ..planners.gbplanner2.local_planner import LocalPlanResult, ShrinkingLocalPlanner
 from ..planners.gbplanner2.planning_map import MapSealer, blocked_spot, mark_blocked_spots, start_pose
 from ..planners.geometry import path_length, xyz
 from ..planners.occupancy import Grid
@@ -274,12 +274,15 @@ class Explore(Skill):
         self.path: np.ndarray | None = None
         self.rerouted = False
         self.frontier: Frontier | None = None
+        #: The local plan being followed (its goal, ``best_vertex``, is no frontier).
+        self.local: LocalPlanResult | None = None
         self.blocked = 0
         self.blocked_at: np.ndarray | None = None
 
     def initialise(self) -> None:
         self.following, self.failures, self.next_plan_s = False, 0, -float("inf")
         self.path, self.rerouted, self.frontier, self.blocked, self.blocked_at = None, False, None, 0, None
+        self.local = None
 
     def update(self) -> Status:
         r = self.robot
@@ -371,7 +374,11 @@ class Explore(Skill):
             # takes over): the frontier is still unexplored; without this the global
             # planner, which dropped it when it planned the path, would never go there.
             self._restore_frontier()
-        self.following = False
+            # Likewise the goal of a local path, which was never a frontier (a COHORT
+            # robot called back to a link point from a ramp it was climbing).
+            if self.local is not None:
+                gbplanner(self.ctx, self.robot).planner.global_planner.add_unreached_goal(self.local)
+        self.following, self.local = False, None
 
     def _plan(self) -> Status:
         r = self.robot
@@ -407,6 +414,7 @@ class Explore(Skill):
             self.follow(res.path)
             self.following, self.path, self.rerouted = True, res.path, False
             self.frontier = _frontier_of(res, svc.planner.global_planner.iteration)
+            self.local = res.local if res.mode == "explore" else None
             length = path_length(res.path)
             self.feedback_message = f"{res.mode}: {length:.1f} m, gain {res.gain:.0f} m3"
             self.event("gbplanner_path", mode=res.mode, gain_m3=round(res.gain, 1), path_length_m=round(length, 2),

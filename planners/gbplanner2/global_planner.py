@@ -243,14 +243,38 @@ class GlobalPlanner:
             chain = graph.vertices[paths.path(int(v))]
             if result.local_map is not None:
                 chain = shortcut_path(result.local_map, chain)
-            ids = self._add_chain(chain[1:], "visited", start=root_v)
-            fv = ids[-1]
-            self.graph.nodes[fv]["kind"] = "frontier"
-            f = Frontier(fv, self._positions[fv].copy(), float(gains[v]), self.iteration, ring_azimuth(graph))
-            self.frontiers[fv] = f
+            added.append(self._frontier_at_end(chain, root_v, float(gains[v]), ring_azimuth(graph)))
             taken.append(p)
-            added.append(f)
         return added
+
+    def _frontier_at_end(self, chain: np.ndarray, start: int, gain: float, ring_azimuth_rad: float) -> Frontier:
+        """Join ``chain`` (positions along admissible edges from vertex ``start``) to the
+        graph and make its last vertex a frontier."""
+        fv = self._add_chain(chain[1:], "visited", start=start)[-1]
+        self.graph.nodes[fv]["kind"] = "frontier"
+        f = Frontier(fv, self._positions[fv].copy(), gain, self.iteration, ring_azimuth_rad)
+        self.frontiers[fv] = f
+        return f
+
+    def add_unreached_goal(self, result: LocalPlanResult) -> Frontier | None:
+        """The robot was stopped on the way to the vertex of G_L whose path ``result``
+        commanded (``best_vertex``, left out of the frontiers because the robot was going
+        there): make it a frontier, joined to the graph by its path from the plan's start,
+        unless its gain is below ``frontier_gain_min_m3`` or a frontier lies within
+        ``frontier_spacing_m``. Returns the frontier added, if any."""
+        graph, paths, gains = result.graph, result.shortest_paths, result.vertex_gains
+        v = result.best_vertex
+        if graph is None or paths is None or gains is None or v <= 0 or result.root is None:
+            return None
+        p, cfg = graph.vertices[v], self.config
+        if gains[v] < cfg.frontier_gain_min_m3 or any(
+                np.linalg.norm(f.position - p) < cfg.frontier_spacing_m for f in self.frontiers.values()):
+            return None
+        chain = graph.vertices[paths.path(int(v))]
+        if result.local_map is not None:
+            chain = shortcut_path(result.local_map, chain)
+        return self._frontier_at_end(chain, self._add_vertex(result.root, "visited"), float(gains[v]),
+                                     ring_azimuth(graph))
 
     def update_frontiers(self, grid: Grid, near: np.ndarray | None = None, radius_m: float | None = None) -> None:
         """Recompute the gain of the frontiers (those within ``radius_m`` of ``near``, or
