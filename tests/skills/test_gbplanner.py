@@ -294,6 +294,24 @@ def test_a_frontier_halted_on_the_way_to_goes_back_to_the_global_planner(half_ma
     assert gp.graph.nodes[10**6]["kind"] == ("frontier" if halted else "visited")
 
 
+@pytest.mark.parametrize("halted", [True, False])
+def test_the_goal_of_a_local_path_halted_on_the_way_becomes_a_frontier(half_mapped, halted):
+    """The local path's goal is no frontier (the robot is going there); Explore halted on
+    the way (a COHORT robot called back to a link point) makes it one."""
+    grid, a, _ = half_mapped
+    robot = FakeRobot(grid, body(a, 8.0))
+    ctx = make_ctx(robot)
+    node = explore(ctx)
+    node.tick_once()
+    assert node.following and bb("planner_mode") == "explore"
+    gp = gbplanner(ctx, robot, node.overrides).planner.global_planner
+    goal = node.local.graph.vertices[node.local.best_vertex]
+    near = lambda: [f for f in gp.frontiers.values() if np.linalg.norm(f.position - goal) < 0.5]  # noqa: E731
+    assert not near()
+    node.stop(Status.INVALID if halted else Status.SUCCESS)
+    assert len(near()) == (1 if halted else 0) and node.local is None
+
+
 def test_explore_stays_inside_the_exploration_box(half_mapped):
     grid, a, _ = half_mapped
     robot = FakeRobot(grid, body(a, 12.0))
