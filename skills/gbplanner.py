@@ -184,7 +184,9 @@ class Explore(Skill):
     re-planned on the terrain-aware navigation graph of the onboard map, to the
     farthest of its poses that graph reaches (``reroute_poses``); where that is
     blocked too (a step or trench finer than the voxels), the planner sees rock from
-    then on (``no_go_radius_m``) and plans again.
+    then on (``no_go_radius_m``) and plans again. Halted on the way (a COHORT call, a
+    safety block), it leaves the global planner the frontier of a repositioning path,
+    or the goal of a local path as a new frontier, so that the direction is not lost.
     The planner's parameters come from the robot's platform (Table I preset: ``legged``
     ANYmal C, ``aerial`` RMF-Obelix) and its mobility limits; the parameters below that
     are not null override them, and ``planner`` overrides any GBPlannerConfig field.
@@ -274,8 +276,9 @@ class Explore(Skill):
         self.path: np.ndarray | None = None
         self.rerouted = False
         self.frontier: Frontier | None = None
-        #: The local plan being followed (its goal, ``best_vertex``, is no frontier).
-        self.local: LocalPlanResult | None = None
+        #: The local plan being followed (its goal, ``best_vertex``, is no frontier) and
+        #: the global graph's vertex of its start.
+        self.local: tuple[LocalPlanResult, int] | None = None
         self.blocked = 0
         self.blocked_at: np.ndarray | None = None
 
@@ -377,7 +380,7 @@ class Explore(Skill):
             # Likewise the goal of a local path, which was never a frontier (a COHORT
             # robot called back to a link point from a ramp it was climbing).
             if self.local is not None:
-                gbplanner(self.ctx, self.robot).planner.global_planner.add_unreached_goal(self.local)
+                gbplanner(self.ctx, self.robot).planner.global_planner.add_unreached_goal(*self.local)
         self.following, self.local = False, None
 
     def _plan(self) -> Status:
@@ -414,7 +417,8 @@ class Explore(Skill):
             self.follow(res.path)
             self.following, self.path, self.rerouted = True, res.path, False
             self.frontier = _frontier_of(res, svc.planner.global_planner.iteration)
-            self.local = res.local if res.mode == "explore" else None
+            gp = svc.planner.global_planner
+            self.local = (res.local, gp.robot_vertex) if res.mode == "explore" and res.local else None
             length = path_length(res.path)
             self.feedback_message = f"{res.mode}: {length:.1f} m, gain {res.gain:.0f} m3"
             self.event("gbplanner_path", mode=res.mode, gain_m3=round(res.gain, 1), path_length_m=round(length, 2),

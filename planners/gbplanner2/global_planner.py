@@ -240,41 +240,48 @@ class GlobalPlanner:
             p = graph.vertices[v]
             if taken and np.min(np.linalg.norm(np.asarray(taken) - p, axis=1)) < cfg.frontier_spacing_m:
                 continue
-            chain = graph.vertices[paths.path(int(v))]
-            if result.local_map is not None:
-                chain = shortcut_path(result.local_map, chain)
-            added.append(self._frontier_at_end(chain, root_v, float(gains[v]), ring_azimuth(graph)))
+            added.append(self._frontier_at_end(result, int(v), root_v))
             taken.append(p)
         return added
 
-    def _frontier_at_end(self, chain: np.ndarray, start: int, gain: float, ring_azimuth_rad: float) -> Frontier:
-        """Join ``chain`` (positions along admissible edges from vertex ``start``) to the
-        graph and make its last vertex a frontier."""
+    def _frontier_at_end(self, result: LocalPlanResult, v: int, start: int) -> Frontier:
+        """Join the path of G_L's vertex ``v`` (shortcut on the iteration's local map) to
+        the global graph from vertex ``start`` (the iteration's root) and make its end a
+        frontier with ``v``'s gain. Writes ``graph`` and ``frontiers``; returns the frontier."""
+        graph, paths, gains = result.graph, result.shortest_paths, result.vertex_gains
+        assert graph is not None and paths is not None and gains is not None
+        chain = graph.vertices[paths.path(v)]
+        if result.local_map is not None:
+            chain = shortcut_path(result.local_map, chain)
         fv = self._add_chain(chain[1:], "visited", start=start)[-1]
         self.graph.nodes[fv]["kind"] = "frontier"
-        f = Frontier(fv, self._positions[fv].copy(), gain, self.iteration, ring_azimuth_rad)
+        f = Frontier(fv, self._positions[fv].copy(), float(gains[v]), self.iteration, ring_azimuth(graph))
         self.frontiers[fv] = f
         return f
 
-    def add_unreached_goal(self, result: LocalPlanResult) -> Frontier | None:
+    def add_unreached_goal(self, result: LocalPlanResult, start: int) -> Frontier | None:
         """The robot was stopped on the way to the vertex of G_L whose path ``result``
         commanded (``best_vertex``, left out of the frontiers because the robot was going
-        there): make it a frontier, joined to the graph by its path from the plan's start,
-        unless its gain is below ``frontier_gain_min_m3`` or a frontier lies within
-        ``frontier_spacing_m``. Returns the frontier added, if any."""
+        there; ``start``: the global vertex of the iteration's root): make it a frontier as
+        :meth:`add_local_result` makes the others (joined by its path, its new vertices
+        to their neighbours), unless it could not have been one (gain under
+        ``frontier_gain_min_m3``, hanging, unreachable) or lies within
+        ``frontier_spacing_m`` of the start or of a frontier. Writes ``graph`` and
+        ``frontiers``; returns the frontier added, if any."""
         graph, paths, gains = result.graph, result.shortest_paths, result.vertex_gains
-        v = result.best_vertex
-        if graph is None or paths is None or gains is None or v <= 0 or result.root is None:
+        v, cfg = result.best_vertex, self.config
+        if graph is None or paths is None or gains is None or v <= 0:
             return None
-        p, cfg = graph.vertices[v], self.config
-        if gains[v] < cfg.frontier_gain_min_m3 or any(
-                np.linalg.norm(f.position - p) < cfg.frontier_spacing_m for f in self.frontiers.values()):
+        p = graph.vertices[v]
+        near = [self._positions[start], *(f.position for f in self.frontiers.values())]
+        if (gains[v] < cfg.frontier_gain_min_m3 or graph.hanging[v] or not paths.reachable[v]
+                or np.min(np.linalg.norm(np.asarray(near) - p, axis=1)) < cfg.frontier_spacing_m):
             return None
-        chain = graph.vertices[paths.path(int(v))]
+        first_new = len(self._positions)
+        f = self._frontier_at_end(result, int(v), start)
         if result.local_map is not None:
-            chain = shortcut_path(result.local_map, chain)
-        return self._frontier_at_end(chain, self._add_vertex(result.root, "visited"), float(gains[v]),
-                                     ring_azimuth(graph))
+            self._link_neighbours(result.local_map, np.arange(first_new, len(self._positions)))
+        return f
 
     def update_frontiers(self, grid: Grid, near: np.ndarray | None = None, radius_m: float | None = None) -> None:
         """Recompute the gain of the frontiers (those within ``radius_m`` of ``near``, or

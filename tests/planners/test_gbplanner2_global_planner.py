@@ -52,19 +52,24 @@ def test_frontiers_are_recorded_where_the_gain_is(tunnel):
 def test_the_goal_of_a_local_path_the_robot_did_not_reach_becomes_a_frontier(tunnel):
     _g, a, home = tunnel
     gp, (r,) = explored(tunnel, [a + np.array([25.0, 0, 0.5])])
-    goal = r.graph.vertices[r.best_vertex]
-    assert r.vertex_gains[r.best_vertex] >= CFG.frontier_gain_min_m3
+    start, goal = gp.robot_vertex, r.graph.vertices[r.best_vertex]
+    assert r.vertex_gains[r.best_vertex] >= CFG.frontier_gain_min_m3 and not r.graph.hanging[r.best_vertex]
     assert all(np.linalg.norm(f.position - goal) >= CFG.frontier_spacing_m for f in gp.frontiers.values())
     before = set(gp.frontiers)
-    f = gp.add_unreached_goal(r)
+    f = gp.add_unreached_goal(r, start)
     assert f is not None and set(gp.frontiers) == before | {f.vertex}
     assert np.linalg.norm(f.position - goal) < CFG.global_vertex_merge_radius_m + 1e-9
     assert gp.graph.nodes[f.vertex]["kind"] == "frontier" and f.gain == r.vertex_gains[r.best_vertex]
-    assert nx.has_path(gp.graph, gp.home_vertex, f.vertex)                 # joined by its path from the start
-    assert gp.add_unreached_goal(r) is None                                 # one there already
-    r.vertex_gains[r.best_vertex] = CFG.frontier_gain_min_m3 - 1
+    way = np.array([gp.position_of(v) for v in nx.shortest_path(gp.graph, start, f.vertex, weight="weight")])
+    assert len(way) > 1 and segments_admissible(r.local_map, way).all()   # joined by its path
+    assert nx.has_path(gp.graph, gp.home_vertex, f.vertex)
+    assert gp.add_unreached_goal(r, start) is None                          # one there already
     del gp.frontiers[f.vertex]
-    assert gp.add_unreached_goal(r) is None                                 # too little gain left
+    r.graph.hanging[r.best_vertex] = True
+    assert gp.add_unreached_goal(r, start) is None                          # no ground under it
+    r.graph.hanging[r.best_vertex] = False
+    r.vertex_gains[r.best_vertex] = CFG.frontier_gain_min_m3 - 1
+    assert gp.add_unreached_goal(r, start) is None                          # too little gain left
 
 
 def test_repositioning_after_k_low_gain_iterations(tunnel):

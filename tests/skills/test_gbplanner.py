@@ -305,7 +305,8 @@ def test_the_goal_of_a_local_path_halted_on_the_way_becomes_a_frontier(half_mapp
     node.tick_once()
     assert node.following and bb("planner_mode") == "explore"
     gp = gbplanner(ctx, robot, node.overrides).planner.global_planner
-    goal = node.local.graph.vertices[node.local.best_vertex]
+    local, _start = node.local
+    goal = local.graph.vertices[local.best_vertex]
     near = lambda: [f for f in gp.frontiers.values() if np.linalg.norm(f.position - goal) < 0.5]  # noqa: E731
     assert not near()
     node.stop(Status.INVALID if halted else Status.SUCCESS)
