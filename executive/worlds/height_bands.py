@@ -44,6 +44,12 @@ class HeightBand:
         """Whether each of ``points`` ((N, 3), m) lies in the band."""
         return self.holds_heights(np.asarray(points, float).reshape(-1, 3)[:, 2])
 
+    def layers(self, origin_z: float, voxel_size_m: float, nz: int) -> slice:
+        """The voxel layers (of ``nz`` from ``origin_z``) whose centres lie in the band, as
+        a slice: a grid's ``[..., band.layers(...)]`` is a view, not a copy."""
+        at = np.flatnonzero(self.holds_heights(origin_z + (np.arange(nz) + 0.5) * voxel_size_m))
+        return slice(int(at[0]), int(at[-1]) + 1) if len(at) else slice(0, 0)
+
     def within(self, points: np.ndarray) -> np.ndarray:
         """The ``points`` ((N, 3), m) that lie in the band."""
         points = np.asarray(points, float).reshape(-1, 3)

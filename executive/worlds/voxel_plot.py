@@ -136,10 +136,9 @@ def plot_voxel_map(mission: "Mission", truth_voxels: np.ndarray, path: Path) -> 
     for robot in mission.robots.values():
         seen |= robot.onboard_map.occupancy == 0
         walls |= robot.onboard_map.occupancy == 1
-    layers = world.origin[2] + (np.arange(world.free.shape[2]) + 0.5) * world.voxel_size_m
     title = f"{mission.scenario.name}: team coverage {mission.state.samples[-1].team:.0%}"
     for k, (ax, band, left) in enumerate(zip(axes[:, 0], bands, frontiers_left(mission, bands))):
-        at = band.holds_heights(layers)
+        at = band.layers(float(world.origin[2]), world.voxel_size_m, world.free.shape[2])
         _draw_band(ax, mission, band, (truth[..., at], seen[..., at], walls[..., at]), extent, left)
         ax.set_xlabel("x (m)")
         ax.set_ylabel("y (m)")

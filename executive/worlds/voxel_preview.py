@@ -42,7 +42,6 @@ def draw_preview(scenario: "Scenario", world: World, starts: list["StartPlacemen
     other = (labels > 0) & ~main
     n_regions = int(np.count_nonzero(sizes))
     bands = height_bands(world.free, float(world.origin[2]), world.voxel_size_m)
-    layers = world.origin[2] + (np.arange(world.shape[2]) + 0.5) * world.voxel_size_m
     paths = []
     for name, (a, b), flat in (("top", (0, 1), 2), ("side", (0, 2), 1)):
         lo, hi = world.bounds_min, world.bounds_max
@@ -53,7 +52,7 @@ def draw_preview(scenario: "Scenario", world: World, starts: list["StartPlacemen
         fw, fh = _figsize(w, h * stretch)
         fig, axes = plt.subplots(len(views), 1, figsize=(fw, fh * len(views)), squeeze=False)
         for ax, band in zip(axes[:, 0], views):
-            at = band.holds_heights(layers)
+            at = band.layers(float(world.origin[2]), world.voxel_size_m, world.shape[2])
             img = np.empty((world.shape[a], world.shape[b], 3))
             img[:] = ROCK_RGB
             img[other[..., at].any(axis=flat)] = OTHER_RGB

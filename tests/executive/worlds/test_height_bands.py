@@ -33,6 +33,7 @@ def test_two_levels_joined_by_a_shaft_are_two_bands_cut_in_the_shafts_middle():
     points = np.array([[0, 0, -5.0], [0, 0, low.hi_m - 0.01], [0, 0, low.hi_m], [0, 0, 40.0]])
     assert low.holds(points).tolist() == [True, True, False, False]
     assert high.holds(points).tolist() == [False, False, True, True]
+    assert low.layers(-1.0, VOXEL, 100) == slice(0, cut) and high.layers(-1.0, VOXEL, 100) == slice(cut, 100)
 
 
 def test_one_level_is_every_height():
