@@ -418,7 +418,7 @@ class Explore(Skill):
             self.following, self.path, self.rerouted = True, res.path, False
             self.frontier = _frontier_of(res, svc.planner.global_planner.iteration)
             gp = svc.planner.global_planner
-            self.local = (res.local, gp.robot_vertex) if res.mode == "explore" and res.local else None
+            self.local = (res.local, gp.robot_vertex) if res.mode == "explore" and res.local is not None else None
             length = path_length(res.path)
             self.feedback_message = f"{res.mode}: {length:.1f} m, gain {res.gain:.0f} m3"
             self.event("gbplanner_path", mode=res.mode, gain_m3=round(res.gain, 1), path_length_m=round(length, 2),

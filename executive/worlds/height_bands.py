@@ -118,12 +118,11 @@ def _join_small(cuts: list[int], free: np.ndarray, counts: np.ndarray) -> list[i
             a, b = spans[k]
             return float(np.average(layer[a:b], weights=counts[a:b]))
 
-        def cost(j: int) -> tuple[int, float]:
-            """Columns band ``i`` shares with band ``j``, then how far apart their free volumes' centres are."""
-            return np.count_nonzero(own & free[..., slice(*spans[j])].any(axis=2)), abs(centre(j) - centre(i))
-
-        j = min((k for k in (i - 1, i + 1) if 0 <= k < len(spans)), key=cost)
-        if cost(j)[0] > MAX_HIDDEN_SHARE * np.count_nonzero(own):
+        # Per neighbour: the columns band i shares with it, then how far apart their centres are.
+        costs = {j: (np.count_nonzero(own & free[..., slice(*spans[j])].any(axis=2)), abs(centre(j) - centre(i)))
+                 for j in (i - 1, i + 1) if 0 <= j < len(spans)}
+        j = min(costs, key=costs.__getitem__)
+        if costs[j][0] > MAX_HIDDEN_SHARE * np.count_nonzero(own):
             kept.add(i)
             continue
         del cuts[min(i, j)]

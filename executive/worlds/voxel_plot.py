@@ -87,12 +87,11 @@ def long_edges(columns: np.ndarray, voxel_size_m: float, min_length_m: float = M
     return keep[labels]
 
 
-def frontiers_left(mission: "Mission", bands: list[HeightBand] | None = None) -> list[np.ndarray]:
-    """Per height band (``bands``, default one of every height), (N, 2) world x, y of the
+def frontiers_left(mission: "Mission", bands: list[HeightBand]) -> list[np.ndarray]:
+    """Per height band of ``bands``, (N, 2) world x, y of the
     columns drawn as frontiers left: each robot's frontier voxels in the band that open onto
     ground the team did not see (:func:`open_frontiers`), seen from above, in edges of at
     least :data:`MIN_EDGE_M` (:func:`long_edges`)."""
-    bands = bands or [ALL_HEIGHTS]
     maps = [robot.onboard_map for robot in mission.robots.values()]
     if not maps:
         return [np.zeros((0, 2)) for _ in bands]

@@ -238,11 +238,16 @@ class GlobalPlanner:
             if len(added) >= cfg.frontiers_per_iteration_max:
                 break
             p = graph.vertices[v]
-            if taken and np.min(np.linalg.norm(np.asarray(taken) - p, axis=1)) < cfg.frontier_spacing_m:
+            if self._crowded(p, taken):
                 continue
             added.append(self._frontier_at_end(result, int(v), root_v))
             taken.append(p)
         return added
+
+    def _crowded(self, p: np.ndarray, taken: list[np.ndarray]) -> bool:
+        """Whether a frontier at ``p`` would lie within ``frontier_spacing_m`` of one of ``taken``."""
+        return bool(taken) and float(np.min(np.linalg.norm(np.asarray(taken) - p, axis=1))) < \
+            self.config.frontier_spacing_m
 
     def _frontier_at_end(self, result: LocalPlanResult, v: int, start: int) -> Frontier:
         """Join the path of G_L's vertex ``v`` (shortcut on the iteration's local map) to
@@ -272,10 +277,9 @@ class GlobalPlanner:
         v, cfg = result.best_vertex, self.config
         if graph is None or paths is None or gains is None or v <= 0:
             return None
-        p = graph.vertices[v]
         near = [self._positions[start], *(f.position for f in self.frontiers.values())]
         if (gains[v] < cfg.frontier_gain_min_m3 or graph.hanging[v] or not paths.reachable[v]
-                or np.min(np.linalg.norm(np.asarray(near) - p, axis=1)) < cfg.frontier_spacing_m):
+                or self._crowded(graph.vertices[v], near)):
             return None
         first_new = len(self._positions)
         f = self._frontier_at_end(result, int(v), start)
