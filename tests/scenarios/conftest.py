@@ -11,9 +11,14 @@ from delve.executive.scenario import load_scenario
 DATA = Path(__file__).parent / "data"
 
 
-def run_scenario(path: Path, out: Path | None = None, **kw) -> tuple[Mission, dict]:
-    """Run a scenario; write its outputs into ``out`` when given. Returns the mission and report."""
-    mission = Mission(load_scenario(path), **kw)
+def run_scenario(path: Path, out: Path | None = None, *, endurance_s: dict[str, float] | None = None,
+                 **kw) -> tuple[Mission, dict]:
+    """Run a scenario, its robots' endurances replaced by ``endurance_s`` (by robot name) to
+    keep a test short; write its outputs into ``out`` when given. Returns the mission and report."""
+    scenario = load_scenario(path)
+    for robot in scenario.robots:
+        robot.endurance_s = (endurance_s or {}).get(robot.name, robot.endurance_s)
+    mission = Mission(scenario, **kw)
     mission.run()
     report = write_outputs(mission, out, 1.0) if out is not None else None
     return mission, report

@@ -85,7 +85,7 @@ def test_unreachable_goal_is_reported_to_the_supervisor():
 
 
 def test_invalid_start_pose_resets_the_local_map_and_retries():
-    mission, _ = run_scenario(SCENARIOS_DIR / "cerberus_map_reset.yaml")
+    mission, _ = run_scenario(SCENARIOS_DIR / "cerberus_map_reset.yaml", endurance_s={"anymal": 300})
     (fault,) = events(mission, "fault", kind="map_artifact")
     resets = [e for e in events(mission, "local_map_reset") if e["t"] >= fault["t"]]
     assert resets and resets[0]["t"] <= fault["t"] + 30

@@ -7,7 +7,10 @@ from .test_cerberus import ends_well
 
 
 def test_legged_robot_refuses_the_steep_ramp_while_the_aerial_robot_flies_the_shaft():
-    mission, _ = run_scenario(SCENARIOS_DIR / "cerberus_slopes_shaft.yaml")
+    # The ANYmal is at the ramp's foot at about 100 s, the aerial robot above the upper
+    # floor at about 130 s: short endurances keep the test short.
+    mission, _ = run_scenario(SCENARIOS_DIR / "cerberus_slopes_shaft.yaml",
+                              endurance_s={"anymal": 300, "obelix": 260})
     g = mission.world.centreline
     upper_floor = min(float(g.nodes[n]["pos"][2]) for n in g.nodes if g.nodes[n].get("level") == 1)
     legged_top = max(p[2] for p in mission.robots["anymal"].traversed_path)

@@ -3,22 +3,31 @@ on a quiet machine and on a busy one."""
 import json
 import multiprocessing
 import os
+from pathlib import Path
 
+import pytest
 from delve import SCENARIOS_DIR
 from delve.executive.outputs import strip_wall_clock
 
 from .conftest import DATA, run_scenario
 
 
-def test_same_seed_same_report_and_log(tmp_path):
-    _, a = run_scenario(DATA / "small_tunnel.yaml", tmp_path / "a")
+@pytest.fixture(scope="module")
+def small_tunnel(tmp_path_factory) -> tuple[dict, Path]:
+    """small_tunnel.yaml's report and output folder, run once for this module."""
+    out = tmp_path_factory.mktemp("small_tunnel")
+    return run_scenario(DATA / "small_tunnel.yaml", out)[1], out
+
+
+def test_same_seed_same_report_and_log(small_tunnel, tmp_path):
+    a, out = small_tunnel
     _, b = run_scenario(DATA / "small_tunnel.yaml", tmp_path / "b")
     assert json.dumps(strip_wall_clock(a)) == json.dumps(strip_wall_clock(b))
-    assert (tmp_path / "a" / "log.jsonl").read_bytes() == (tmp_path / "b" / "log.jsonl").read_bytes()
+    assert (out / "log.jsonl").read_bytes() == (tmp_path / "b" / "log.jsonl").read_bytes()
 
 
-def test_another_seed_gives_another_run(tmp_path):
-    _, a = run_scenario(DATA / "small_tunnel.yaml", tmp_path / "a")
+def test_another_seed_gives_another_run(small_tunnel, tmp_path):
+    a, _ = small_tunnel
     _, c = run_scenario(DATA / "small_tunnel.yaml", tmp_path / "c", seed=99)
     assert c["seed"] == 99
     assert strip_wall_clock(a) != strip_wall_clock(c)
