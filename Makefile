@@ -10,8 +10,10 @@ STAMP := $(VENV)/.installed
 demo: setup
 	$(BIN)/delve demo
 
+# The tests run on every core (at most 4), a test file per worker: its module fixtures
+# (a scenario run several tests read) then run once.
 test: setup
-	$(BIN)/python -m pytest
+	$(BIN)/python -m pytest -n auto --maxprocesses 4 --dist loadfile
 
 setup: system-deps $(STAMP)
 

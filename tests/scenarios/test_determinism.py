@@ -56,8 +56,9 @@ def _without_wall_clock(log: str) -> list[dict]:
 def test_cops_plans_do_not_depend_on_the_machine_s_load(tmp_path):
     """cops_under_load's solves are large enough that the former wall-clock limits bound
     under load (its plans then differed from a quiet run's). Its limits are counted in
-    work now: run quiet, then with every core spinning, it gives the same report and
-    log (solve times aside), and no safety stop fired."""
+    work now: run once as the suite runs it (beside another test worker under `make
+    test`), then with every core spinning, it gives the same report and log (solve times
+    aside), and no safety stop fired."""
     _, quiet = run_scenario(DATA / "cops_under_load.yaml", tmp_path / "quiet")
     ctx = multiprocessing.get_context("spawn")
     stop = ctx.Event()
