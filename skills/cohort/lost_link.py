@@ -74,17 +74,23 @@ class ReturnToLinkPoint(GoTo):
     """The lost-link rule's way back: go to the last point that offered a link to the
     hub (``cohort_link_points``, written by ``CallHub``; the robot's home comes before
     the first), ping the hub there, and when it does not answer (or the point cannot be
-    reached) go on to the point before, and so on.
+    reached) go on to the point before, and so on. On the way it pings the hub every
+    ``ping_every_s``: the way back is for the link, so an answer ends it where the
+    robot is (the paper names the point, not what the robot does when the link comes
+    back sooner).
 
     The way flown is added to GBPlanner2's global graph as ``FollowHubPath`` adds
     its own. Reads ``cohort_link_points``; writes ``goto_failure`` as ``GoTo``. Logs
-    ``cohort_backtrack`` when it sets out and ``cohort_link_point`` at each point
-    reached (linked or not). Returns RUNNING on the way; SUCCESS at a point where the
-    hub answers; FAILURE when no point offers a link.
+    ``cohort_backtrack`` when it sets out, ``cohort_link_point`` at each point
+    reached (linked or not) and ``cohort_link_regained`` where a ping on the way was
+    answered. Returns RUNNING on the way; SUCCESS where the hub answers; FAILURE when
+    no point offers a link.
     """
 
     PARAMS = {**{k: v for k, v in GoTo.PARAMS.items() if k not in ("goal", "goal_key")},
               "ping_attempts": Param(int, 3, "pings tried at a point before it counts as without link", minimum=1),
+              "ping_every_s": Param(float, 2.0, "on the way, one ping this often; an answer ends the way back",
+                                    exclusive_minimum=0),
               "graph_spacing_m": Param(float, 2.0, "the way flown joins GBPlanner2's global graph a vertex this "
                                        "far apart", exclusive_minimum=0)}
     INPUT_PORTS = {"cohort_link_points": PortInformation(list, required=False, default_value=[],
@@ -94,9 +100,13 @@ class ReturnToLinkPoint(GoTo):
     def __init__(self, name: str, ctx: Any, remap: dict[str, str] | None = None, **params: Any):
         super().__init__(name, ctx, remap, goal=None, **params)
         self.points: list[np.ndarray] = []
+        self.next_ping_s = float("inf")
+        self.regained = False
 
     def initialise(self) -> None:
         super().initialise()
+        self.next_ping_s = self.ctx.clock.now_s + self.p["ping_every_s"]
+        self.regained = False
         r = self.robot
         self.points = [r.home.copy(), *(np.asarray(p, float) for p in self.read("cohort_link_points") or [])]
         self.goal = self.points.pop()
@@ -111,7 +121,19 @@ class ReturnToLinkPoint(GoTo):
         record_transit(self.ctx, self.robot, self.p["graph_spacing_m"])
         return status
 
+    def reached(self) -> bool:
+        """At the link point, or the hub answered this tick's ping on the way."""
+        if super().reached():
+            return True
+        if self.ctx.clock.now_s >= self.next_ping_s:
+            self.next_ping_s = self.ctx.clock.now_s + self.p["ping_every_s"]
+            self.regained = linked(self.robot.radio, 1)
+        return self.regained
+
     def arrived(self) -> Status:
+        if self.regained:
+            self.event("cohort_link_regained", at=xyz(self.robot.position, 2), to=xyz(self.goal, 2))
+            return Status.SUCCESS
         ok = linked(self.robot.radio, self.p["ping_attempts"])
         self.event("cohort_link_point", at=xyz(self.goal, 2), linked=ok)
         return Status.SUCCESS if ok else self._next("no link there")

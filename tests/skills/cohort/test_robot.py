@@ -13,6 +13,7 @@ from delve.skills.cohort.lost_link import CohortTimer, ExplorationOver, ReturnTo
 from delve.skills.cohort.hub import ASSIGNMENT, REQUEST, SUBMAP
 from delve.skills.cohort.robot import CallHub, FollowHubPath, SendSubmaps
 from delve.skills.gbplanner import SERVICE as GBPLANNER, gbplanner
+from delve.skills.robot import PathStatus
 from py_trees.common import Status
 
 from ..fakes import FakeRobot, bb, body, events, make_ctx, run
@@ -268,7 +269,7 @@ def test_return_goes_back_point_by_point_until_one_offers_a_link(tunnel):
     points = [body(a, 8.0).tolist(), body(a, 20.0).tolist()]
     py_trees.blackboard.Blackboard.set("/r1/cohort_link_points", points)
     robot.radio.link_up = False
-    node = ReturnToLinkPoint(name="Back", ctx=ctx, tolerance_m=0.5)
+    node = ReturnToLinkPoint(name="Back", ctx=ctx, tolerance_m=0.5, ping_every_s=1000.0)  # pings at points only
     assert tick(node, ctx, robot, 15) == Status.RUNNING
     reached = events(ctx, "cohort_link_point")
     assert len(reached) == 1 and reached[0]["linked"] is False and reached[0]["at"] == list(np.round(points[1], 2))
@@ -276,6 +277,23 @@ def test_return_goes_back_point_by_point_until_one_offers_a_link(tunnel):
     assert run(node, ctx, robot) == Status.SUCCESS
     assert np.linalg.norm(robot.position - points[0]) <= 0.5
     assert events(ctx, "cohort_backtrack")[0]["to"] == list(np.round(points[1], 2))
+
+
+def test_return_ends_where_a_ping_on_the_way_is_answered(tunnel):
+    grid, a, _ = tunnel
+    robot = FakeRobot(grid, body(a, 30.0), home=body(a, 1.0))
+    ctx = ctx_for(robot)
+    py_trees.blackboard.Blackboard.set("/r1/cohort_link_points", [body(a, 5.0).tolist()])
+    robot.radio.link_up = False
+    node = ReturnToLinkPoint(name="Back", ctx=ctx, tolerance_m=0.5, ping_every_s=2.0)
+    assert tick(node, ctx, robot, 6) == Status.RUNNING
+    assert [t for t, _ in robot.radio.pings] == [2.0, 4.0]   # one ping every 2 s, none answered
+    robot.radio.link_up = True
+    assert run(node, ctx, robot) == Status.SUCCESS
+    (regained,) = events(ctx, "cohort_link_regained")
+    assert regained["at"] == list(np.round(robot.position, 2)) and regained["to"] == list(np.round(body(a, 5.0), 2))
+    assert body(a, 5.0)[0] + 5.0 < robot.position[0] < body(a, 30.0)[0]   # on the way, well short of the point
+    assert not events(ctx, "cohort_link_point") and robot.path_status != PathStatus.FOLLOWING
 
 
 def test_return_ends_at_home_and_fails_when_no_point_links(tunnel):
