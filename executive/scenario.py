@@ -299,6 +299,17 @@ def _team(doc: YamlDict, path: Path, tree_types: set[type]) -> TeamSpec:
     return TeamSpec(strategy, params)
 
 
+def _check_agent_kind(types: set[type], kind: str, what: str, path: Path, line: int | None) -> None:
+    """A behaviour that belongs in the other kind of agent's tree (``AGENT`` of a
+    skill: "robot" or "base") in the tree of a ``kind`` agent: a mistake at its
+    ``tree:`` line (built, it would fail at its first tick)."""
+    wrong = sorted(getattr(c, "TYPE_NAME", c.__name__) for c in types if getattr(c, "AGENT", None) not in (None, kind))
+    if wrong:
+        why = "which needs a robot (the base station has none)" if kind == "base" else \
+            "a behaviour of the base station (it belongs in base_station: tree:)"
+        raise DelveError(f"{what} uses {wrong[0]}, {why}", path, line)
+
+
 def _check_hub_needed(doc: YamlDict, path: Path, robots: list[RobotSpec], robot_types: dict[str, set[type]]) -> None:
     """A robot tree whose behaviours belong to a strategy that needs a base station
     tree, in a scenario with neither: a mistake at that robot's ``tree:`` line."""
@@ -360,6 +371,8 @@ def load_scenario(path: str | Path, include_path: Iterable[str | Path] = (),
         names.add(r["name"])
         tree = _tree_file(path, r["tree"], include_path, f"robot {short_repr(r['name'])}: tree", r.key_line("tree"))
         robot_types[r["name"]] = check_tree(tree, include_path=include_path)
+        _check_agent_kind(robot_types[r["name"]], "robot", f"robot {short_repr(r['name'])}: its tree", path,
+                          r.key_line("tree"))
         tree_types |= robot_types[r["name"]]
         extra = {k: float(r[k]) for k in ("speed_mps", "max_inclination_deg", "max_step_m") if k in r}
         robots.append(RobotSpec(name=r["name"], platform=r["platform"], tree=tree, start=r.get("start"),
@@ -370,10 +383,12 @@ def load_scenario(path: str | Path, include_path: Iterable[str | Path] = (),
                                 start_line=r.key_line("start")))
 
     base = doc.get("base_station", {})
-    base_tree = None
+    base_tree, base_types = None, set()
     if "tree" in base:
         base_tree = _tree_file(path, base["tree"], include_path, "base station tree", base.key_line("tree"))
-        tree_types |= check_tree(base_tree, include_path=include_path)
+        base_types = check_tree(base_tree, include_path=include_path)
+        _check_agent_kind(base_types, "base", "base station tree", path, base.key_line("tree"))
+        tree_types |= base_types
     supervisor = load_supervisor(doc.get("supervisor"), path, {r.name: r.breadcrumbs for r in robots})
     faults = load_faults(doc.get("faults"), FaultContext(path, {r.name: r for r in robots}, robot_types, backend,
                                                          base_tree is not None))
@@ -389,6 +404,9 @@ def load_scenario(path: str | Path, include_path: Iterable[str | Path] = (),
         name = next(n for n, s in TEAM_STRATEGIES.items() if s is team.strategy)
         raise DelveError(f"team strategy {name!r} needs a base station tree (base_station: tree: ...)", path,
                          doc.key_line("team"))
+    problem = team.strategy.base_tree_problem(base_types) if base_tree is not None else None
+    if problem:
+        raise DelveError(problem, path, base.key_line("tree"))
     return Scenario(path=path, name=doc["name"], seed=int(values["seed"]), duration_s=float(values["duration_s"]),
                     dt_s=float(values["dt_s"]), coverage_period_s=float(values["coverage_period_s"]),
                     world=plain(doc["world"]), robots=robots, base_tree=base_tree,

@@ -309,6 +309,10 @@ class Skill(py_trees.behaviour.Behaviour):
     PARAMS: ClassVar[dict[str, Param]] = {}
     INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {}
     OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {}
+    #: The agent whose tree the skill belongs in: ``"robot"`` (it needs one), ``"base"``
+    #: (it reads the base station's services) or None (either); a scenario that puts it
+    #: in the other kind's tree is refused when it is loaded.
+    AGENT: ClassVar[str | None] = "robot"
 
     # The declarations are py_trees' own (PortInformation in INPUT_PORTS/OUTPUT_PORTS),
     # but the keys are not wired through PortsMixin.setup_ports: a port nobody remaps

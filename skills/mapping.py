@@ -53,6 +53,8 @@ class MergeMaps(Skill):
     Returns RUNNING (it is a background task).
     """
 
+    AGENT = "base"
+
     def __init__(self, name: str, ctx: Any, remap: dict[str, str] | None = None, **params: Any):
         super().__init__(name, ctx, remap, **params)
         if "radio" in ctx.services:  # not when a tree is only checked

@@ -42,6 +42,7 @@ class Timer(Skill):
         Never FAILURE.
     """
 
+    AGENT = None
     PARAMS = {
         "duration_s": Param(float, REQUIRED, doc="sim time to wait, in seconds", minimum=0.0),
     }

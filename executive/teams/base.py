@@ -47,6 +47,12 @@ class TeamStrategy(ABC):
         return False
 
     @classmethod
+    def base_tree_problem(cls, base_tree_types: set[type]) -> str | None:
+        """What the base station tree (nodes of ``base_tree_types``) lacks for this
+        strategy, as one sentence; None when nothing."""
+        return None
+
+    @classmethod
     def check_world(cls, scenario: "Scenario", world: Any) -> None:
         """Check the strategy's parameters against the built world (its size, say); a
         :class:`~delve.executive.errors.DelveError` with the scenario's line if wrong."""

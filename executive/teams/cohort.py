@@ -112,15 +112,17 @@ class Cohort(TeamStrategy):
     def base_services(self) -> dict[str, Any]:
         return {PARAMS_SERVICE: self.cohort}
 
+    @classmethod
+    def base_tree_problem(cls, base_tree_types: set[type]) -> str | None:
+        """A base station tree without the hub: the robots' calls would go unanswered."""
+        if any(c.__name__ == HUB_BEHAVIOUR for c in base_tree_types):
+            return None
+        return f"team strategy 'cohort': the base station tree has no COHORT hub ({HUB_BEHAVIOUR}; " \
+               "see trees/cohort_hub.yaml)"
+
     def start(self, mission: "Mission") -> None:
-        """The hub's home is the first robot's (a Dijkstra source on G_C). A base station
-        tree without the hub is a mistake: the robots' calls would go unanswered."""
-        base = mission.agents[BASE]
-        if not any(type(n).__name__ == HUB_BEHAVIOUR for n in base.root.iterate()):
-            raise DelveError(f"team strategy 'cohort': the base station tree has no COHORT hub ({HUB_BEHAVIOUR}; "
-                             "see trees/cohort_hub.yaml)", mission.scenario.path,
-                             mission.scenario.doc["base_station"].key_line("tree"))
-        base.ctx.services[HOME_SERVICE] = next(iter(mission.robots.values())).home.copy()
+        """The hub's home is the first robot's (a Dijkstra source on G_C)."""
+        mission.agents[BASE].ctx.services[HOME_SERVICE] = next(iter(mission.robots.values())).home.copy()
 
     def hub(self, mission: "Mission") -> Any:
         """The hub's state on the base station (None before its first submap)."""

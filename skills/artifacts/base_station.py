@@ -50,6 +50,7 @@ class CollectArtifactReports(Skill):
     ``artifact_report``). Writes ``artifact_candidates``. Logs an
     ``artifact_delivered`` event per report. Returns RUNNING (a background task)."""
 
+    AGENT = "base"
     OUTPUT_PORTS = CANDIDATES_PORT
 
     def __init__(self, name: str, ctx: Any, remap: dict[str, str] | None = None, **params: Any):
@@ -82,6 +83,7 @@ class SubmitArtifacts(Skill):
     per submission (its verdict, error, reason). Returns RUNNING (a background
     task)."""
 
+    AGENT = "base"
     PARAMS = {
         "policy": Param(str, SubmissionParams.policy, "immediate or best_first", choices=SUBMISSION_POLICIES),
         "strong_probability": Param(float, SubmissionParams.strong_probability,

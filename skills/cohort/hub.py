@@ -54,6 +54,7 @@ class HubSkill(Skill):
     an agent with a radio (not when a tree is only checked)."""
 
     ABSTRACT = True
+    AGENT = "base"
     CLAIMS: str | None = None
 
     def __init__(self, name: str, ctx: Any, remap: dict[str, str] | None = None, **params: Any):
@@ -104,6 +105,8 @@ class UpdateGlobalFrontiers(Skill):
     ``cohort_frontiers`` (clusters: size and centroid, largest first; points deleted).
     Returns RUNNING (a background task).
     """
+
+    AGENT = "base"
 
     def update(self) -> Status:
         hub = self.ctx.services.get(HUB_SERVICE)

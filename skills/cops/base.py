@@ -37,6 +37,7 @@ class CopsSkill(Skill):
     ``state``); one that only reads it declares no output port."""
 
     ABSTRACT = True
+    AGENT = None   # the leader's steps run on the base station, the others' on robots
     PARAMS = {"state": STATE_KEY}
     INPUT_PORTS = {"cops": STATE_IN}
     OUTPUT_PORTS = {"cops": STATE_OUT}

@@ -24,6 +24,7 @@ class IsLeader(Skill):
     """Leader?: SUCCESS when this agent plans for the team (``leader``), else FAILURE."""
 
     TYPE_NAME = "Leader?"
+    AGENT = None
     PARAMS = {"leader": Param(str, "base", "name of the agent responsible for planning")}
 
     def update(self) -> Status:

@@ -104,6 +104,8 @@ class CollectFrontiers(Skill):
     ``csiro_uplink`` (robot, frontiers) for a robot's first message after two share periods
     without one. Returns RUNNING (a background task)."""
 
+    AGENT = "base"
+
     def __init__(self, name: str, ctx: Any, remap: dict[str, str] | None = None, **params: Any):
         super().__init__(name, ctx, remap, **params)
         if "radio" in ctx.services:  # not when a tree is only checked

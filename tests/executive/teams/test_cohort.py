@@ -72,10 +72,10 @@ def test_a_box_larger_along_some_axes_only_and_the_default_box_pass(tmp_path):
         s.check_starts(s.build_world())
 
 
-def test_a_base_station_tree_without_the_hub_is_refused(tmp_path):
-    s = scenario(tmp_path, "{strategy: cohort}", base_tree="base_station.yaml")
-    with pytest.raises(DelveError, match="no COHORT hub"):
-        Mission(s)
+def test_a_base_station_tree_without_the_hub_is_refused_when_the_scenario_is_loaded(tmp_path):
+    with pytest.raises(DelveError, match="no COHORT hub") as err:
+        scenario(tmp_path, "{strategy: cohort}", base_tree="base_station.yaml")
+    assert err.value.line == 5   # base_station: {tree: ...}
 
 
 def test_the_hub_gets_the_first_robots_home(tmp_path):
