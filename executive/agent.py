@@ -1,6 +1,7 @@
 """Agents: one per robot and one for the base station, each ticking its own tree."""
 from __future__ import annotations
 
+import uuid
 from dataclasses import dataclass, field
 from typing import Callable
 
@@ -22,6 +23,9 @@ class Agent:
     on_change: Callable[["Agent", py_trees.behaviour.Behaviour, Status, Status], None] | None = None
     next_tick_s: float = 0.0
     ticks: int = 0
+    #: Each node's status when the tree was stopped (None before): stopping leaves every
+    #: node INVALID, and the outputs show where the tree was.
+    stopped_statuses: dict[uuid.UUID, Status] | None = None
     _last: dict = field(default_factory=dict)
 
     def __post_init__(self) -> None:
@@ -48,5 +52,13 @@ class Agent:
         return True
 
     def stop(self) -> None:
-        """Stop the tree (its running behaviours terminate)."""
+        """Stop the tree (its running behaviours terminate), keeping each node's status
+        of the moment in ``stopped_statuses`` (the first time only)."""
+        if self.stopped_statuses is None:
+            self.stopped_statuses = {n.id: n.status for n in self.root.iterate()}
         self.root.stop(Status.INVALID)
+
+    @property
+    def final_status(self) -> Status:
+        """The root's status, or the one it had when the tree was stopped."""
+        return self.root.status if self.stopped_statuses is None else self.stopped_statuses[self.root.id]

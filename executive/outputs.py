@@ -55,7 +55,7 @@ def report(mission: Mission, wall_time_s: float) -> dict[str, Any]:
             "distance_m": round(robot.distance_m, 2),
             "returned_home": bool(np.linalg.norm(robot.true_position - robot.home) <= home_tol),
             "endurance_left_s": round(robot.endurance_remaining_s, 1),
-            "final_status": mission.agents[name].root.status.value,
+            "final_status": mission.agents[name].final_status.value,
             "coverage_fraction": last.robots[name],
             "safety_triggers": dict(sorted(triggers[name].items())),
             "messages_sent": robot.radio.sent,
@@ -118,8 +118,8 @@ def write_outputs(mission: Mission, out: Path, wall_time_s: float) -> dict[str, 
     plot_coverage(mission, out / "coverage.png", mission.backend.COVERAGE_LABEL)
     mission.artifacts.write_plots(mission, out)
     for name, agent in mission.agents.items():
-        render_tree(agent.root, "txt", out / f"tree_{name}.txt")
-        render_tree(agent.root, "svg", out / f"tree_{name}.svg")
+        render_tree(agent.root, "txt", out / f"tree_{name}.txt", agent.stopped_statuses)
+        render_tree(agent.root, "svg", out / f"tree_{name}.svg", agent.stopped_statuses)
     return rep
 
 

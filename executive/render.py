@@ -7,10 +7,15 @@ from __future__ import annotations
 
 import os
 import re
+import uuid
+from collections.abc import Iterator, Mapping
+from contextlib import contextmanager
 from pathlib import Path
 
+import pydot
 import py_trees
 from py_trees.behaviour import Behaviour
+from py_trees.common import Status
 
 from .errors import DelveError
 
@@ -22,22 +27,85 @@ FORMATS = {"svg": "svg", "png": "png", "dot": "raw", "txt": None}
 _ANSI = re.compile(r"\x1b\[[0-9;]*m")
 
 STATUS_LEGEND = "status: \u2713 SUCCESS  \u2715 FAILURE  * RUNNING  - INVALID (not ticked, or stopped)"
+#: The border of a node in a graph dump, by status (INVALID: py_trees' own).
+STATUS_COLOURS = {Status.SUCCESS: "forestgreen", Status.FAILURE: "red3", Status.RUNNING: "blue"}
+GRAPH_LEGEND = "border: green SUCCESS, red FAILURE, blue RUNNING, thin INVALID (not ticked, or stopped)"
+
+Statuses = Mapping[uuid.UUID, Status]
 
 
-def text_tree(root: Behaviour) -> str:
+@contextmanager
+def _showing(root: Behaviour, statuses: Statuses | None) -> Iterator[None]:
+    """Give the nodes the ``statuses`` (by node id) while py_trees' display reads them
+    (a stopped tree's are all INVALID), then put their own back."""
+    nodes = list(root.iterate()) if statuses else []
+    own = [n.status for n in nodes]
+    for n in nodes:
+        n.status = statuses.get(n.id, n.status)  # type: ignore[union-attr]
+    try:
+        yield
+    finally:
+        for n, status in zip(nodes, own):
+            n.status = status
+
+
+def text_tree(root: Behaviour, statuses: Statuses | None = None) -> str:
     """The tree as text (``py_trees.display.unicode_tree`` with ``show_status``): one
-    line per node with its status and feedback message, under a legend of the status
-    symbols; terminal colour codes are removed."""
-    body = py_trees.display.unicode_tree(root, show_status=True)
+    line per node with its status (or the one ``statuses`` gives) and feedback message,
+    under a legend of the status symbols; terminal colour codes are removed."""
+    with _showing(root, statuses):
+        body = py_trees.display.unicode_tree(root, show_status=True)
     return f"# {STATUS_LEGEND}\n{_ANSI.sub('', body)}"
 
 
-def render_tree(root: Behaviour, fmt: str, out_path: str | os.PathLike[str]) -> Path:
+def _dot_names(root: Behaviour) -> Iterator[tuple[Behaviour, str]]:
+    """Each node and its name in ``py_trees.display.dot_tree``'s graph: the node's name
+    with ``*`` added until it is unique, depth first (dot_tree's own naming, which it
+    does not return)."""
+    names: set[str] = {root.name}
+    yield root, root.name
+    stack = [iter(root.children)]
+    while stack:
+        child = next(stack[-1], None)
+        if child is None:
+            stack.pop()
+            continue
+        name = child.name
+        while name in names:
+            name += "*"
+        names.add(name)
+        yield child, name
+        stack.append(iter(child.children))
+
+
+def dot_graph(root: Behaviour, statuses: Statuses | None = None) -> pydot.Dot:
+    """``py_trees.display.dot_tree`` of the tree, each ticked node's border coloured by
+    its status (or the one ``statuses`` gives), with a legend."""
+    graph = py_trees.display.dot_tree(root)
+    ticked = False
+    with _showing(root, statuses):
+        for node, name in _dot_names(root):
+            colour = STATUS_COLOURS.get(node.status)
+            found = graph.get_node(name)
+            if colour and found:
+                found[0].set("color", colour)
+                found[0].set("penwidth", "3")
+                ticked = True
+    if ticked:
+        graph.set("label", GRAPH_LEGEND)
+        graph.set("labelloc", "t")
+        graph.set("fontsize", "10")
+    return graph
+
+
+def render_tree(root: Behaviour, fmt: str, out_path: str | os.PathLike[str],
+                statuses: Statuses | None = None) -> Path:
     """Write the tree under ``root`` to ``out_path`` as ``fmt`` and return the path.
 
-    ``fmt`` is ``svg``, ``png`` or ``dot`` (``py_trees.display.dot_tree`` drawn by
-    graphviz) or ``txt`` (:func:`text_tree`, showing each node's current status, so a
-    dump taken at the end of a run shows the final statuses).
+    ``fmt`` is ``svg``, ``png`` or ``dot`` (:func:`dot_graph` drawn by graphviz) or
+    ``txt`` (:func:`text_tree`). Both show each node's current status, or the one
+    ``statuses`` gives (by node id: a stopped tree's statuses of before), so a dump taken
+    at the end of a run shows the final statuses.
 
     Raises:
         DelveError: an unknown format, or graphviz's ``dot`` missing for svg/png.
@@ -47,9 +115,9 @@ def render_tree(root: Behaviour, fmt: str, out_path: str | os.PathLike[str]) -> 
     out = Path(out_path)
     out.parent.mkdir(parents=True, exist_ok=True)
     if fmt == "txt":
-        out.write_text(text_tree(root), encoding="utf-8")
+        out.write_text(text_tree(root, statuses), encoding="utf-8")
         return out
-    graph = py_trees.display.dot_tree(root)
+    graph = dot_graph(root, statuses)
     try:
         graph.write(str(out), format=FORMATS[fmt])
     except FileNotFoundError as err:

@@ -6,8 +6,9 @@ from pathlib import Path
 
 import py_trees
 import pytest
+from py_trees.common import Status
 from delve.executive.errors import DelveError
-from delve.executive.render import render_tree, text_tree
+from delve.executive.render import dot_graph, render_tree, text_tree
 from delve.executive.tree_loader import load_tree
 from delve.skills.base import AgentContext
 
@@ -43,6 +44,46 @@ def test_txt_shows_every_node_with_its_final_status(ticked_tree, tmp_path):
     assert "[-]" in by_name["Wait 10 s"]
     assert "[\u2713]" in by_name["Note timeout"]
     assert text == text_tree(ticked_tree)
+
+
+@pytest.fixture()
+def running_tree():
+    py_trees.blackboard.Blackboard.clear()
+    ctx = AgentContext(name="r1", namespace="/r1", clock=Clock(), log=lambda *a, **k: None)
+    root = load_tree(TREES / "timed.yaml", ctx)
+    root.tick_once()  # Timer and Timeout run
+    yield root
+    py_trees.blackboard.Blackboard.clear()
+
+
+def line_of(text: str, name: str) -> str:
+    return next(line for line in text.splitlines() if name in line)
+
+
+def test_a_stopped_tree_is_dumped_with_the_statuses_it_had(running_tree):
+    before = {n.id: n.status for n in running_tree.iterate()}
+    running_tree.stop(Status.INVALID)
+    text = text_tree(running_tree, before)
+    assert "[*]" in line_of(text, "Wait 10 s") and "[*]" in line_of(text, "Wait or give up")
+    assert "[-]" in line_of(text_tree(running_tree), "Wait 10 s")
+    assert all(n.status == Status.INVALID for n in running_tree.iterate())   # its own statuses are back
+
+
+def test_the_graph_colours_each_ticked_node_by_its_status(running_tree, ticked_tree):
+    def border(graph, name):
+        (node,) = graph.get_node(name)
+        return node.get("color")
+
+    running = dot_graph(running_tree)
+    assert border(running, "Wait 10 s") == "blue" and "RUNNING" in running.get("label")
+    assert border(running, "Note timeout") is None   # not ticked
+    ticked = dot_graph(ticked_tree)
+    assert border(ticked, "Give up after 5 s") == "red3" and border(ticked, "Note timeout") == "forestgreen"
+    before = {n.id: n.status for n in running_tree.iterate()}
+    running_tree.stop(Status.INVALID)
+    assert border(dot_graph(running_tree, before), "Wait 10 s") == "blue"
+    stopped = dot_graph(running_tree)
+    assert border(stopped, "Wait 10 s") is None and stopped.get("label") is None
 
 
 def test_dot_is_written_without_graphviz(ticked_tree, tmp_path):
