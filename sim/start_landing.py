@@ -60,10 +60,11 @@ def land(world: "World", point: np.ndarray, *, aerial: bool, body_height_m: floa
             out.problem = (f"under rock: an aerial robot hovers {body_height_m:g} m above its start, and "
                            f"{np.round(body, 2).tolist()} is rock{world.nearest_floor_hint(p)}")
             return out
-        clear = clearance_m(world, body, radius_m)
-        if clear < radius_m:
-            out.warnings.append(f"hovers {clear:.2f} m from rock at its start, within its radius of "
-                                f"{radius_m:g} m")
+        need = radius_m + world.voxel_size_m
+        clear = clearance_m(world, body, need)
+        if clear < need:
+            out.warnings.append(f"hovers {clear:.2f} m from rock at its start, within its radius and a voxel "
+                                f"({need:g} m): its planner may find rock inside the robot's box there")
         out.start = p
     else:
         out.start = _on_floor(world, p, max_drop_m)

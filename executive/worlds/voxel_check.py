@@ -8,8 +8,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ...sim.platforms import PLATFORMS
-from ...sim.start_landing import Landing, land
+from ...sim.platforms import PLATFORMS, Platform
+from ...sim.start_landing import Landing, clearance_m, land
 from ...sim.world import World
 from ...sim.world_survey import Survey, survey, world_warnings
 from ...skills.base import short_repr
@@ -49,15 +49,17 @@ def place_starts(scenario: "Scenario", world: World) -> list[StartPlacement]:
     defaults = [np.asarray(world.start, float) + np.array([dx, dy, 0.0]) for dx, dy in START_OFFSETS_M]
     lift = np.array([0.0, 0.0, DEFAULT_START_CLEAR_M])
     defaults = [p for p in defaults if world.is_free((p + lift)[None])[0]]
+    used: set[int] = set()
     out = []
     for i, spec in enumerate(scenario.robots):
         platform = PLATFORMS[spec.platform]
-        if spec.start is None and i >= len(defaults):
+        j = _default_start(world, defaults, i, used, platform) if spec.start is None else None
+        if spec.start is None and j is None:
             landing = Landing(given=np.asarray(world.start, float), problem="no free start pose")
             out.append(StartPlacement(spec.name, spec.platform, False, landing, spec.line, DelveError(
                 f"no free start pose near the world's start for robot #{i + 1}", scenario.path, spec.line)))
             continue
-        point = np.asarray(spec.start, float) if spec.start is not None else defaults[i]
+        point = np.asarray(spec.start, float) if spec.start is not None else defaults[j]
         landing = land(world, point, aerial=platform.aerial, body_height_m=platform.body_height_m,
                        radius_m=platform.radius_m)
         line = spec.start_line if spec.start is not None else spec.line
@@ -68,6 +70,22 @@ def place_starts(scenario: "Scenario", world: World) -> list[StartPlacement]:
                                scenario.path, line)
         out.append(StartPlacement(spec.name, spec.platform, spec.start is not None, landing, line, error))
     return out
+
+
+def _default_start(world: World, defaults: list[np.ndarray], i: int, used: set[int], platform: Platform) -> int | None:
+    """The default start of robot #``i`` (an index into ``defaults``, marked ``used``):
+    the ``i``-th, or for an aerial robot the next one not used where it hovers clear of
+    rock by its radius and a voxel (on the onboard map a wall's voxels reach up to a
+    voxel nearer than the wall, and GBPlanner2 cannot plan from a start with rock inside
+    the robot's box); the first one not used when none is that clear; None when all are."""
+    free = [j for j in [*range(i, len(defaults)), *range(min(i, len(defaults)))] if j not in used]
+    lift = np.array([0.0, 0.0, platform.body_height_m])
+    need = platform.radius_m + world.voxel_size_m
+    j = next((j for j in free if not platform.aerial or clearance_m(world, defaults[j] + lift, need) >= need),
+             free[0] if free else None)
+    if j is not None:
+        used.add(j)
+    return j
 
 
 def describe_voxel_world(scenario: "Scenario", world: World) -> WorldDescription:

@@ -4,6 +4,7 @@ corridor whose header says Y_UP while it is drawn z up (as Gazebo models often a
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -144,3 +145,32 @@ def test_a_graph_world_describes_itself_too():
     assert not d.errors and not d.warnings
     with pytest.raises(DelveError, match="draws no preview"):
         GraphBackend.preview(sc, sc.build_world(), Path("unused"))
+
+
+def test_a_default_aerial_start_keeps_its_radius_and_a_voxel_from_rock(tmp_path):
+    """Seed 1 of this mine has rock 0.65 m from the second default start (1.2 m along x):
+    an aerial robot hovering there found rock inside its box on its own map and never
+    planned; it now takes the next default start that is clear. A legged robot keeps
+    the second one."""
+    from delve.executive.worlds.voxel_check import place_starts
+    from delve.sim.start_landing import clearance_m
+
+    def starts(platform: str) -> tuple[Any, list[np.ndarray]]:
+        path = tmp_path / f"{platform}.yaml"
+        robots = "".join(f"  - {{name: r{i}, platform: {platform}, tree: {TREES_DIR / 'frontier_explorer.yaml'}}}\n"
+                         for i in (1, 2))
+        path.write_text("name: s\nseed: 1\nworld: {generator: tunnel_network, total_length_m: 120, loops: 1, "
+                        f"voxel_size_m: 0.4}}\nrobots:\n{robots}")
+        scenario = load_scenario(path)
+        world = scenario.build_world()
+        placed = place_starts(scenario, world)
+        assert all(p.error is None and not p.landing.warnings for p in placed)
+        return world, [p.landing.start for p in placed]
+
+    world, aerial = starts("aerial")
+    second = np.asarray(world.start) + [1.2, 0.0, 0.0]
+    assert clearance_m(world, second + [0.0, 0.0, 1.0], 2.0) < 0.8
+    assert not np.allclose(aerial[1], second) and not np.allclose(aerial[1], aerial[0])
+    assert clearance_m(world, aerial[1] + [0.0, 0.0, 1.0], 2.0) >= 0.8
+    _, legged = starts("legged")
+    np.testing.assert_allclose(legged[1][:2], second[:2])

@@ -68,7 +68,9 @@ def test_an_aerial_start_is_checked_for_clearance(rooms):
     np.testing.assert_array_equal(ok.start, [5.0, 0.0, 0.5])      # no snapping: it hovers
     tight = aerial(rooms, [5.0, 1.85, 0.0])
     assert tight.problem is None
-    assert tight.warnings and "within its radius of 0.4 m" in tight.warnings[0]
+    assert tight.warnings and "within its radius and a voxel (0.6 m)" in tight.warnings[0]
+    near = aerial(rooms, [5.0, 1.5, 0.0])        # about 0.5 m from the wall: beyond its radius, not a voxel more
+    assert near.problem is None and near.warnings and near.warnings[0].startswith("hovers 0.52 m from rock")
     under = aerial(rooms, [5.0, 0.0, 2.5])
     assert under.problem.startswith("under rock: an aerial robot hovers 1 m above its start")
 
