@@ -44,7 +44,9 @@ class VoxelBackend(WorldBackend):
     base station knows what reached its map (service ``map``)."""
 
     KEYS = ("generator", "mesh")
-    COVERAGE_LABEL = "fraction of free volume observed"
+    #: Counted on the maps as they are at each sample: a voxel a map later reads as rock,
+    #: or a local map reset, takes its share back (the curve may fall).
+    COVERAGE_LABEL = "share of the free volume known as free"
     ARTIFACTS = True
 
     @classmethod
