@@ -27,6 +27,8 @@ from .outpaths import check_out_dir, check_out_file
 from .yamlio import YamlDict, load_yaml
 
 DEMO_SCENARIO = SCENARIOS_DIR / "demo.yaml"
+#: The formats of ``delve render``: render.FORMATS' (not imported here: it loads py_trees and pydot).
+RENDER_FORMATS = ("txt", "svg", "png", "dot")
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -42,8 +44,9 @@ def _parser() -> argparse.ArgumentParser:
     val.add_argument("files", type=Path, nargs="*")
     val.add_argument("--shipped", action="store_true", help="also check every shipped tree and scenario")
     ren = sub.add_parser("render", help="draw a tree file")
-    ren.add_argument("tree", type=Path)
-    ren.add_argument("--format", choices=("svg", "dot", "png", "txt"), default="txt")
+    ren.add_argument("tree", type=Path, help="a tree file (YAML)")
+    ren.add_argument("--format", choices=RENDER_FORMATS,
+                     help="txt (a text tree), svg, png or dot (default: --out's suffix, else txt)")
     ren.add_argument("--out", type=Path, help="output file (default: TREE with the format's suffix)")
     wld = sub.add_parser("world", help="load a scenario's world and say what it is: extent, free space, "
                                        "where each start lands, warnings")
@@ -258,13 +261,21 @@ def validate(files: list[Path], include_path: tuple[Path, ...] = ()) -> int:
     return status
 
 
-def render(tree: Path, fmt: str, out: Path | None, include_path: tuple[Path, ...] = ()) -> int:
+def render(tree: Path, fmt: str | None, out: Path | None, include_path: tuple[Path, ...] = ()) -> int:
+    """``delve render``: the format is ``fmt``, or ``out``'s suffix, or txt; an ``out``
+    whose suffix names another format, or that is the tree file itself, is refused."""
     from ..skills.base import AgentContext
     from .render import render_tree
     from .tree_loader import load_tree
 
-    ctx = AgentContext(name="render", namespace="/render", clock=_Still(), log=lambda *a, **k: None)
+    suffix = out.suffix.lstrip(".").lower() if out is not None else ""
+    if fmt is not None and suffix in RENDER_FORMATS and suffix != fmt:
+        raise DelveError(f"--out {out} has the suffix of {suffix}, not of --format {fmt}")
+    fmt = fmt or (suffix if suffix in RENDER_FORMATS else "txt")
     out = out or tree.with_suffix(f".{fmt}")
+    if out.resolve() == tree.resolve():
+        raise DelveError(f"the {fmt} dump would overwrite the tree file itself: give --out", tree)
+    ctx = AgentContext(name="render", namespace="/render", clock=_Still(), log=lambda *a, **k: None)
     check_out_file(out)
     root = load_tree(tree, ctx, include_path=include_path)
     render_tree(root, fmt, out)

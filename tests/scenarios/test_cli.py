@@ -24,6 +24,19 @@ def test_render_writes_each_format(tmp_path):
         assert out.stat().st_size > 0
 
 
+def test_render_takes_the_format_from_out_and_never_overwrites_the_tree(tmp_path, capsys):
+    tree = DATA.parent.parent.parent / "trees" / "frontier_explorer.yaml"
+    assert main(["render", str(tree), "--out", str(tmp_path / "t.svg")]) == 0
+    assert b"<svg" in (tmp_path / "t.svg").read_bytes()[:400]
+    assert main(["render", str(tree), "--out", str(tmp_path / "u.svg"), "--format", "txt"]) == 2
+    assert "has the suffix of svg, not of --format txt" in capsys.readouterr().err
+    copy = tmp_path / "tree.txt"
+    copy.write_text(tree.read_text())
+    assert main(["render", str(copy), "--include-path", str(tree.parent)]) == 2
+    assert "would overwrite the tree file itself" in capsys.readouterr().err
+    assert copy.read_text() == tree.read_text() and not (tmp_path / "u.svg").exists()
+
+
 def test_validate_prints_the_world_warnings_and_start_errors(tmp_path, capsys):
     from delve import TREES_DIR
 
