@@ -121,6 +121,16 @@ def _ply_has_faces(path: Path) -> bool:
     return False
 
 
+def _why(err: Exception, fmt: str) -> str:
+    """Why a reader failed, in words that quote nothing of the file (a reader's own
+    message may): where XML stops being well-formed, else that the file is broken or
+    not of its kind, with the reader's exception's name."""
+    if isinstance(err, ET.ParseError) and getattr(err, "position", None):
+        line, column = err.position
+        return f"not well-formed XML at line {line}, column {column + 1}"
+    return f"a broken file, or not a {fmt} file ({type(err).__name__} in its reader)"
+
+
 def _read_with_trimesh(path: Path, fmt: str) -> Geometry:
     import trimesh
 
@@ -131,7 +141,7 @@ def _read_with_trimesh(path: Path, fmt: str) -> Geometry:
         scene = trimesh.load(str(path), force="scene", process=False)
         meshes = [g for g in scene.dump() if isinstance(g, trimesh.Trimesh) and len(g.faces)]
     except Exception as err:   # noqa: BLE001 - any reader failure is the file's fault
-        raise ValueError(f"cannot read {fmt} file '{path.name}': {type(err).__name__}") from None
+        raise ValueError(f"cannot read {fmt} file '{path.name}': {_why(err, fmt)}") from None
     finally:
         quiet.setLevel(level)
     if not meshes:
@@ -172,7 +182,7 @@ def _read_points(path: Path) -> Geometry:
         try:
             arr = np.load(path, allow_pickle=False)
         except (ValueError, OSError) as err:
-            raise ValueError(f"cannot read point cloud '{path.name}': {type(err).__name__}") from None
+            raise ValueError(f"cannot read point cloud '{path.name}': {_why(err, 'NumPy')}") from None
         if arr.ndim != 2 or arr.shape[1] < 3 or not np.issubdtype(arr.dtype, np.number):
             raise ValueError(f"cannot read point cloud '{path.name}': a .npy world is an (N, 3) array of "
                              f"x, y, z (more columns are ignored), not shape {arr.shape}")
@@ -196,7 +206,7 @@ def read_sdf_model(path: Path) -> Geometry:
     try:
         root = ET.parse(path).getroot()
     except (ET.ParseError, OSError) as err:
-        raise ValueError(f"cannot read SDF file '{path.name}': {type(err).__name__}") from None
+        raise ValueError(f"cannot read SDF file '{path.name}': {_why(err, 'SDF')}") from None
     parts_v, parts_t, n = [], [], 0
     for link in root.iter("link"):
         link_pose = _sdf_pose(link.find("pose"))

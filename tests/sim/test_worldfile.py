@@ -185,7 +185,9 @@ def test_a_gazebo_model_folder(tmp_path):
     ("x.las", "", "unknown kind '.las'"),
     ("x.npy", None, "a .npy world is an \\(N, 3\\) array"),
     ("x.xyz", "", "no points in it"),
-    ("x.dae", "<COLLADA>", "cannot read Collada file 'x.dae'"),
+    ("x.dae", "<COLLADA>", "cannot read Collada file 'x.dae': a broken file, or not a Collada file"),
+    ("x.sdf", "<sdf><model>\n  <link name=x>", "cannot read SDF file 'x.sdf': not well-formed XML at line 2, column"),
+    ("x.gltf", "not json: root:x:0:0", "cannot read glTF file 'x.gltf': a broken file, or not a glTF file"),
 ])
 def test_unreadable_files_say_so(tmp_path, name, text, message):
     path = tmp_path / name
@@ -193,5 +195,6 @@ def test_unreadable_files_say_so(tmp_path, name, text, message):
         np.save(path, np.zeros((4, 2)))
     else:
         path.write_text(text)
-    with pytest.raises(ValueError, match=message):
+    with pytest.raises(ValueError, match=message) as err:
         from_file(path)
+    assert "root:x" not in str(err.value)   # nothing of the file is quoted
