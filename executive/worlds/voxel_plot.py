@@ -113,6 +113,10 @@ def frontiers_left(mission: "Mission", bands: list[HeightBand]) -> list[np.ndarr
     return out
 
 
+#: The fills of a top view: free space nobody saw, free space the team saw, mapped rock.
+FREE_UNSEEN_RGB, SEEN_RGB, WALL_RGB = (0.85, 0.85, 0.85), (0.72, 0.84, 0.95), (0.35, 0.35, 0.35)
+
+
 def plot_voxel_map(mission: "Mission", truth_voxels: np.ndarray, path: Path) -> None:
     """Top-down map: free space, what the team saw, walls, paths (flying robots' dashed, on
     top), the frontiers left at the end that open onto unseen ground (:func:`frontiers_left`),
@@ -162,9 +166,14 @@ def _draw_band(ax: Any, mission: "Mission", band: HeightBand, grids: tuple[np.nd
     links, base station, artifacts and the team strategy's marks."""
     truth, seen, walls = grids
     img = np.ones(truth.shape[:2][::-1] + (3,))
-    img[_top_down(truth)] = (0.85, 0.85, 0.85)
-    img[_top_down(seen)] = (0.72, 0.84, 0.95)
-    img[_top_down(walls) & ~_top_down(seen)] = (0.35, 0.35, 0.35)
+    saw = _top_down(seen)
+    rock = _top_down(walls) & ~saw
+    fills = ((_top_down(truth) & ~saw & ~rock, FREE_UNSEEN_RGB, "free space the team did not see"),
+             (saw, SEEN_RGB, "free space the team saw"), (rock, WALL_RGB, "rock the team mapped"))
+    for where, rgb, label in fills:
+        img[where] = rgb
+        if where.any():
+            ax.fill([], [], color=rgb, label=label)   # a legend entry for the fill
     ax.imshow(img, origin="lower", extent=extent, interpolation="nearest")
     colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     for i, (name, robot) in enumerate(mission.robots.items()):
@@ -187,7 +196,8 @@ def _draw_band(ax: Any, mission: "Mission", band: HeightBand, grids: tuple[np.nd
     # Labelled once: on the first robot with links here (robot 0 on a world of one level).
     first = next((i for i, p in enumerate(links) if len(p)), 0 if band is ALL_HEIGHTS else None)
     for i, pos in enumerate(links):
-        ax.plot(pos[:, 0], pos[:, 1], "o", ms=3, color="green", zorder=1.9,   # under the paths
+        # Gold with a dark edge: no robot's path has that colour.
+        ax.plot(pos[:, 0], pos[:, 1], "o", ms=3.5, mfc="gold", mec="0.2", mew=0.5, zorder=1.9,   # under the paths
                 label="radio link to base" if i == first else None)
     if band.holds(mission.base_position).all():
         ax.plot(*mission.base_position[:2], "k^", ms=9, label="base station")
