@@ -96,12 +96,16 @@ def test_the_report_counts_per_robot_and_lists_the_assignments():
     events = [{"event": "cohort_submap_sent", "agent": "r1"}, {"event": "cohort_submap_sent", "agent": "r1"},
               {"event": "cohort_call", "agent": "r1", "reached": True},
               {"event": "cohort_call", "agent": "r2", "reached": False},
-              {"event": "cohort_assignment_received", "agent": "r1"},
-              {"event": "cohort_extra_exploration", "agent": "r2"}, {"event": "cohort_backtrack", "agent": "r2"}]
+              {"event": "cohort_assignment_received", "agent": "r1", "frontier": None},
+              {"event": "cohort_assignment_received", "agent": "r1", "frontier": [1.0, 2.0, 0.5]},
+              {"event": "cohort_extra_exploration", "agent": "r2"}, {"event": "cohort_backtrack", "agent": "r2"},
+              {"event": "cohort_link_regained", "agent": "r2"}]
     fig = cohort_figures(events, ["r1", "r2"], fake_hub())
     r1, r2 = fig["robots"]["r1"], fig["robots"]["r2"]
-    assert (r1["submaps_sent"], r1["submaps_received"], r1["calls"], r1["assignments"]) == (2, 2, 1, 1)
+    assert (r1["submaps_sent"], r1["submaps_received"], r1["calls"], r1["assignments"]) == (2, 2, 1, 2)
+    assert r1["frontiers_received"] == 1 and r2["frontiers_received"] == 0
     assert (r2["calls_out_of_reach"], r2["extra_explorations"], r2["lost_link_backtracks"]) == (1, 1, 1)
+    assert (r1["links_regained_on_the_way"], r2["links_regained_on_the_way"]) == (0, 1)
     assert fig["submaps_at_hub"] == 3 and fig["frontier_clusters_at_end"] == 1 and fig["frontier_points_at_end"] == 300
     assert fig["assignments"] == [{"robot": "r1", "t": 50.0, "request_id": 1, "reason": "ok",
                                    "frontier": [10.0, 2.0, 1.0], "cluster_size": 300, "distance_m": 12.3}]
