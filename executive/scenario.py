@@ -169,7 +169,8 @@ def _schema_error(err: jsonschema.ValidationError, doc: Any, path: Path) -> Delv
         return DelveError("world: give one of 'generator', 'mesh' or 'network'", path, line)
     if err.validator == "enum":
         choices = ", ".join(map(repr, err.validator_value))
-        return DelveError(f"{where}: {short_repr(err.instance)} is not one of {choices}", path, line)
+        hint = did_you_mean(err.instance, map(str, err.validator_value)) if isinstance(err.instance, str) else ""
+        return DelveError(f"{where}: {short_repr(err.instance)} is not one of {choices}{hint}", path, line)
     message = err.message
     shown = repr(err.instance)
     if len(shown) > len(short_repr(err.instance)):
