@@ -33,6 +33,7 @@ RENDER_FORMATS = ("txt", "svg", "png", "dot")
 
 def _parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="delve", description="Behaviour-tree mission executive for subterranean robot teams.")
+    p.add_argument("--version", action="version", version=f"%(prog)s {_version()}")
     sub = p.add_subparsers(dest="command", required=True)
     run = sub.add_parser("run", help="run a scenario and write its outputs")
     run.add_argument("scenario", type=Path, help="a scenario file, or the name of a shipped one (demo, cops_tunnel, ...)")
@@ -41,7 +42,7 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("--duration-s", type=float, help="override the scenario's duration (sim seconds)")
     run.add_argument("--quiet", action="store_true", help="no progress bar")
     val = sub.add_parser("validate", help="check tree and scenario files")
-    val.add_argument("files", type=Path, nargs="*")
+    val.add_argument("files", type=Path, nargs="*", help="tree and scenario files (each is told apart by its keys)")
     val.add_argument("--shipped", action="store_true", help="also check every shipped tree and scenario")
     ren = sub.add_parser("render", help="draw a tree file")
     ren.add_argument("tree", type=Path, help="a tree file (YAML)")
@@ -67,8 +68,18 @@ def _parser() -> argparse.ArgumentParser:
                              help="a folder that tree includes may also resolve into (besides the tree's own "
                                   "folder and the shipped trees); repeatable")
     demo = sub.add_parser("demo", help="run the default scenario into ./delve-out/demo")
-    demo.add_argument("--quiet", action="store_true")
+    demo.add_argument("--quiet", action="store_true", help="no progress bar")
     return p
+
+
+def _version() -> str:
+    """The installed package's version."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("delve")
+    except PackageNotFoundError:
+        return "(not installed)"
 
 
 def _one_line_warning(message, category, filename, lineno, file=None, line=None) -> None:  # noqa: ANN001

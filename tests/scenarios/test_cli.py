@@ -37,6 +37,14 @@ def test_render_takes_the_format_from_out_and_never_overwrites_the_tree(tmp_path
     assert copy.read_text() == tree.read_text() and not (tmp_path / "u.svg").exists()
 
 
+def test_version(capsys):
+    import pytest
+
+    with pytest.raises(SystemExit) as done:
+        main(["--version"])
+    assert done.value.code == 0 and capsys.readouterr().out.startswith("delve ")
+
+
 def test_validate_prints_the_world_warnings_and_start_errors(tmp_path, capsys):
     from delve import TREES_DIR
 
