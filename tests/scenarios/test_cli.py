@@ -1,6 +1,7 @@
 """The command line: exit status 0 for a successful mission, 1 for a failed one."""
 import json
 
+import pytest
 from delve.executive.cli import main
 
 from .conftest import DATA
@@ -38,8 +39,6 @@ def test_render_takes_the_format_from_out_and_never_overwrites_the_tree(tmp_path
 
 
 def test_version(capsys):
-    import pytest
-
     with pytest.raises(SystemExit) as done:
         main(["--version"])
     assert done.value.code == 0 and capsys.readouterr().out.startswith("delve ")
