@@ -124,15 +124,17 @@ def write_outputs(mission: Mission, out: Path, wall_time_s: float) -> dict[str, 
 
 
 def plot_coverage(mission: Mission, path: Path, ylabel: str) -> None:
-    """Explored fraction over sim time: team, base station, robots."""
+    """Explored fraction over sim time: team and base station (black), robots (each in
+    its colour on map.png: the colour cycle's, in the scenario's order)."""
     s = mission.state.samples
     t = np.array([x.t for x in s]) / 60.0
     fig, ax = plt.subplots(figsize=(7, 4))
-    ax.plot(t, [x.team for x in s], lw=2, label="team")
-    ax.plot(t, [x.base for x in s], lw=2, ls="--", label="known at base station")
+    ax.plot(t, [x.team for x in s], lw=2, color="black", label="team")
+    ax.plot(t, [x.base for x in s], lw=2, ls="--", color="0.45", label="known at base station")
     if len(mission.robots) > 1:
-        for name in mission.robots:
-            ax.plot(t, [x.robots[name] for x in s], lw=1, label=name)
+        colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+        for i, name in enumerate(mission.robots):
+            ax.plot(t, [x.robots[name] for x in s], lw=1, color=colours[i % len(colours)], label=name)
     ax.set_xlabel("sim time (min)")
     ax.set_ylabel(ylabel)
     ax.set_ylim(0, 1.02)
