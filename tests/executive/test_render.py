@@ -19,16 +19,31 @@ class Clock:
     now_s = 0.0
 
 
-@pytest.fixture()
-def ticked_tree():
+@pytest.fixture(autouse=True)
+def blackboard():
     py_trees.blackboard.Blackboard.clear()
+    yield
+    py_trees.blackboard.Blackboard.clear()
+
+
+def timed_tree(ticks_at_s: tuple[float, ...]) -> py_trees.behaviour.Behaviour:
+    """tests/data/trees/timed.yaml ticked at the sim times ``ticks_at_s``."""
     ctx = AgentContext(name="r1", namespace="/r1", clock=Clock(), log=lambda *a, **k: None)
     root = load_tree(TREES / "timed.yaml", ctx)
-    root.tick_once()  # Timer and Timeout run
-    ctx.clock.now_s = 6.0
-    root.tick_once()  # the timeout fires; the selector falls back to the note
-    yield root
-    py_trees.blackboard.Blackboard.clear()
+    for t in ticks_at_s:
+        ctx.clock.now_s = t
+        root.tick_once()
+    return root
+
+
+@pytest.fixture()
+def ticked_tree():
+    return timed_tree((0.0, 6.0))   # Timer and Timeout run; then the timeout fires, the note is set
+
+
+@pytest.fixture()
+def running_tree():
+    return timed_tree((0.0,))   # Timer and Timeout run
 
 
 def test_txt_shows_every_node_with_its_final_status(ticked_tree, tmp_path):
@@ -44,16 +59,6 @@ def test_txt_shows_every_node_with_its_final_status(ticked_tree, tmp_path):
     assert "[-]" in by_name["Wait 10 s"]
     assert "[\u2713]" in by_name["Note timeout"]
     assert text == text_tree(ticked_tree)
-
-
-@pytest.fixture()
-def running_tree():
-    py_trees.blackboard.Blackboard.clear()
-    ctx = AgentContext(name="r1", namespace="/r1", clock=Clock(), log=lambda *a, **k: None)
-    root = load_tree(TREES / "timed.yaml", ctx)
-    root.tick_once()  # Timer and Timeout run
-    yield root
-    py_trees.blackboard.Blackboard.clear()
 
 
 def line_of(text: str, name: str) -> str:

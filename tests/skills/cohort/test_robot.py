@@ -262,14 +262,21 @@ def test_exploration_over(robot, homing, complete, box, over):
 # ----------------------------------------------------------------- ReturnToLinkPoint
 
 
-def test_return_goes_back_point_by_point_until_one_offers_a_link(tunnel):
+def returning(tunnel, from_m: float, points_m: list[float], **params):
+    """A robot ``from_m`` along the tunnel with link points at ``points_m``, its link
+    down, and its ReturnToLinkPoint (``params``); returns the robot, its ctx and the node."""
     grid, a, _ = tunnel
-    robot = FakeRobot(grid, body(a, 30.0), home=body(a, 1.0))
+    robot = FakeRobot(grid, body(a, from_m), home=body(a, 1.0))
     ctx = ctx_for(robot)
-    points = [body(a, 8.0).tolist(), body(a, 20.0).tolist()]
-    py_trees.blackboard.Blackboard.set("/r1/cohort_link_points", points)
+    py_trees.blackboard.Blackboard.set("/r1/cohort_link_points", [body(a, x).tolist() for x in points_m])
     robot.radio.link_up = False
-    node = ReturnToLinkPoint(name="Back", ctx=ctx, tolerance_m=0.5, ping_every_s=1000.0)  # pings at points only
+    return robot, ctx, ReturnToLinkPoint(name="Back", ctx=ctx, tolerance_m=0.5, **params)
+
+
+def test_return_goes_back_point_by_point_until_one_offers_a_link(tunnel):
+    _, a, _ = tunnel
+    points = [body(a, 8.0).tolist(), body(a, 20.0).tolist()]
+    robot, ctx, node = returning(tunnel, 30.0, [8.0, 20.0], ping_every_s=1000.0)  # pings at points only
     assert tick(node, ctx, robot, 15) == Status.RUNNING
     reached = events(ctx, "cohort_link_point")
     assert len(reached) == 1 and reached[0]["linked"] is False and reached[0]["at"] == list(np.round(points[1], 2))
@@ -280,12 +287,8 @@ def test_return_goes_back_point_by_point_until_one_offers_a_link(tunnel):
 
 
 def test_return_ends_where_a_ping_on_the_way_is_answered(tunnel):
-    grid, a, _ = tunnel
-    robot = FakeRobot(grid, body(a, 30.0), home=body(a, 1.0))
-    ctx = ctx_for(robot)
-    py_trees.blackboard.Blackboard.set("/r1/cohort_link_points", [body(a, 5.0).tolist()])
-    robot.radio.link_up = False
-    node = ReturnToLinkPoint(name="Back", ctx=ctx, tolerance_m=0.5, ping_every_s=2.0)
+    _, a, _ = tunnel
+    robot, ctx, node = returning(tunnel, 30.0, [5.0], ping_every_s=2.0)
     assert tick(node, ctx, robot, 6) == Status.RUNNING
     assert [t for t, _ in robot.radio.pings] == [2.0, 4.0]   # one ping every 2 s, none answered
     robot.radio.link_up = True
@@ -297,12 +300,7 @@ def test_return_ends_where_a_ping_on_the_way_is_answered(tunnel):
 
 
 def test_return_ends_at_home_and_fails_when_no_point_links(tunnel):
-    grid, a, _ = tunnel
-    robot = FakeRobot(grid, body(a, 20.0), home=body(a, 1.0))
-    ctx = ctx_for(robot)
-    py_trees.blackboard.Blackboard.set("/r1/cohort_link_points", [body(a, 10.0).tolist()])
-    robot.radio.link_up = False
-    node = ReturnToLinkPoint(name="Back", ctx=ctx, tolerance_m=0.5)
+    robot, ctx, node = returning(tunnel, 20.0, [10.0])
     assert run(node, ctx, robot) == Status.FAILURE
     assert np.linalg.norm(robot.position - robot.home) <= 0.5
     assert [e["linked"] for e in events(ctx, "cohort_link_point")] == [False, False]
