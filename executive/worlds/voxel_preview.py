@@ -100,10 +100,21 @@ def _draw_starts(ax, world: World, starts: list["StartPlacement"], scenario: "Sc
     triangle."""
     a, b = axes
     seen: dict[str, Line2D] = {}
+    named: list[tuple[np.ndarray, int]] = []   # each name's point and row
+    # Names of starts closer than this (6 % of the view) go one above the other, with a line.
+    near_m = 0.06 * float(max(world.free.shape[a], world.free.shape[b]) * world.voxel_size_m)
 
     def mark(p, style, label, **kw):
         (h,) = ax.plot(p[a], p[b], style, ms=kw.pop("ms", 9), label=label, **kw)
         seen.setdefault(label, h)
+
+    def name(p, text, **kw):
+        q = np.array([p[a], p[b]], float)
+        row = max((k + 1 for r, k in named if np.linalg.norm(q - r) < near_m), default=0)
+        named.append((q, row))
+        line = dict(arrowstyle="-", lw=0.6, color="0.3", shrinkA=0, shrinkB=4) if row else None
+        ax.annotate(text, tuple(q), xytext=(6, 6 + 11 * row), textcoords="offset points", fontsize=8,
+                    arrowprops=line, **kw)
 
     for s in starts:
         ld = s.landing
@@ -115,8 +126,7 @@ def _draw_starts(ax, world: World, starts: list["StartPlacement"], scenario: "Sc
             if floor is not None:
                 ax.plot([ld.given[a], floor[a]], [ld.given[b], floor[b]], ":", color="red", lw=1.2)
                 mark(floor, "P", "nearest free floor", color="green", mec="white")
-            ax.annotate(s.name, (ld.given[a], ld.given[b]), xytext=(6, 6), textcoords="offset points",
-                        color="red", fontsize=8)
+            name(ld.given, s.name, color="red")
             continue
         if ld.moved_m > 0:
             ax.annotate("", xy=(ld.start[a], ld.start[b]), xytext=(ld.given[a], ld.given[b]),
@@ -124,7 +134,7 @@ def _draw_starts(ax, world: World, starts: list["StartPlacement"], scenario: "Sc
             mark(ld.start, "o", "start moved onto the floor", color="darkorange", mec="black")
         else:
             mark(ld.start, "o", "start", color="limegreen", mec="black")
-        ax.annotate(s.name, (ld.start[a], ld.start[b]), xytext=(6, 6), textcoords="offset points", fontsize=8)
+        name(ld.start, s.name)
     if scenario.base_position is not None and band.holds(scenario.base_position).all():
         mark(np.asarray(scenario.base_position, float), "^", "base station", color="black")
     return list(seen.values())
