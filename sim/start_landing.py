@@ -20,6 +20,9 @@ if TYPE_CHECKING:
 
 #: How far below a legged robot's given start its floor is looked for.
 SNAP_DOWN_M = 2.0
+#: Half the height of the box a hovering robot's planner keeps free of rock (GBPlanner2's
+#: aerial robot boxes are 0.2-0.4 m high).
+HOVER_BOX_HALF_HEIGHT_M = 0.2
 #: A start in a free region of less than this share of the largest region's volume gets a warning.
 SMALL_REGION_SHARE = 0.1
 
@@ -60,11 +63,11 @@ def land(world: "World", point: np.ndarray, *, aerial: bool, body_height_m: floa
             out.problem = (f"under rock: an aerial robot hovers {body_height_m:g} m above its start, and "
                            f"{np.round(body, 2).tolist()} is rock{world.nearest_floor_hint(p)}")
             return out
-        need = radius_m + world.voxel_size_m
-        clear = clearance_m(world, body, need)
-        if clear < need:
+        if not hover_clear(world, body, radius_m):
+            clear = clearance_m(world, body, radius_m + world.voxel_size_m)
             out.warnings.append(f"hovers {clear:.2f} m from rock at its start, within its radius and a voxel "
-                                f"({need:g} m): its planner may find rock inside the robot's box there")
+                                f"({radius_m + world.voxel_size_m:g} m) in some direction: its planner may find "
+                                "rock inside the robot's box there")
         out.start = p
     else:
         out.start = _on_floor(world, p, max_drop_m)
@@ -94,6 +97,19 @@ def _on_floor(world: "World", p: np.ndarray, max_drop_m: float) -> np.ndarray | 
     if abs(p[2] - floor_z) <= v:
         return p.copy()
     return np.array([p[0], p[1], floor_z])
+
+
+def hover_clear(world: "World", body: np.ndarray, radius_m: float) -> bool:
+    """Whether every voxel of the box a robot hovering at ``body`` keeps free (``radius_m``
+    to each side, :data:`HOVER_BOX_HALF_HEIGHT_M` up and down), grown by a voxel, is free:
+    on the robot's map a wall's voxels reach up to a voxel nearer than the wall, and
+    GBPlanner2 does not plan from a start with rock inside the robot's box."""
+    v = world.voxel_size_m
+    half = np.array([radius_m + v, radius_m + v, HOVER_BOX_HALF_HEIGHT_M + v])
+    lo, hi = world.to_index(np.stack([body - half, body + half]))
+    if not world.in_bounds(np.stack([lo, hi])).all():
+        return False
+    return bool(world.free[lo[0]:hi[0] + 1, lo[1]:hi[1] + 1, lo[2]:hi[2] + 1].all())
 
 
 def clearance_m(world: "World", point: np.ndarray, up_to_m: float) -> float:

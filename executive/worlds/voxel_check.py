@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ...sim.platforms import PLATFORMS, Platform
-from ...sim.start_landing import Landing, clearance_m, land
+from ...sim.start_landing import Landing, hover_clear, land
 from ...sim.world import World
 from ...sim.world_survey import Survey, survey, world_warnings
 from ...skills.base import short_repr
@@ -74,15 +74,13 @@ def place_starts(scenario: "Scenario", world: World) -> list[StartPlacement]:
 
 def _default_start(world: World, defaults: list[np.ndarray], i: int, used: set[int], platform: Platform) -> int | None:
     """The default start of robot #``i`` (an index into ``defaults``, marked ``used``):
-    the ``i``-th, or for an aerial robot the next one not used where it hovers clear of
-    rock by its radius and a voxel (on the onboard map a wall's voxels reach up to a
-    voxel nearer than the wall, and GBPlanner2 cannot plan from a start with rock inside
-    the robot's box); the first one not used when none is that clear; None when all are."""
-    free = [j for j in [*range(i, len(defaults)), *range(min(i, len(defaults)))] if j not in used]
-    lift = np.array([0.0, 0.0, platform.body_height_m])
-    need = platform.radius_m + world.voxel_size_m
-    j = next((j for j in free if not platform.aerial or clearance_m(world, defaults[j] + lift, need) >= need),
-             free[0] if free else None)
+    the first from the ``i``-th on that no robot before took and, for an aerial robot,
+    where it hovers clear of rock (:func:`~delve.sim.start_landing.hover_clear`; else
+    the first not taken, with a warning); None when none is left."""
+    left = [j for j in range(i, len(defaults)) if j not in used]
+    body = np.array([0.0, 0.0, platform.body_height_m])
+    j = next((j for j in left if not platform.aerial or hover_clear(world, defaults[j] + body, platform.radius_m)),
+             left[0] if left else None)
     if j is not None:
         used.add(j)
     return j
