@@ -233,7 +233,7 @@ def _run_with_progress(mission) -> None:
 
         def update(m) -> None:
             s = m.state.samples[-1] if m.state.samples else None
-            states = " ".join(f"{n}:{a.root.status.value}" for n, a in m.agents.items() if n != "base")
+            states = " ".join(f"{n}:{a.final_status.value}" for n, a in m.agents.items() if n != "base")
             cov = f"coverage {s.team:.0%}" if s else ""
             # After the end, the clock runs on while the radio delivers what is queued: show the end.
             t = m.clock.now_s if m.finished_s is None else m.finished_s

@@ -15,11 +15,11 @@ from pathlib import Path
 import pydot
 import py_trees
 from py_trees.behaviour import Behaviour
-from py_trees.common import Status
+from py_trees.common import Status, VisibilityLevel
 
 from .errors import DelveError
 
-__all__ = ["FORMATS", "render_tree", "text_tree"]
+__all__ = ["FORMATS", "dot_graph", "render_tree", "text_tree"]
 
 #: Formats :func:`render_tree` writes, and the pydot format behind each graph one.
 FORMATS = {"svg": "svg", "png": "png", "dot": "raw", "txt": None}
@@ -58,13 +58,18 @@ def text_tree(root: Behaviour, statuses: Statuses | None = None) -> str:
     return f"# {STATUS_LEGEND}\n{_ANSI.sub('', body)}"
 
 
+def _shown_children(node: Behaviour) -> list[Behaviour]:
+    """The children ``py_trees.display.dot_tree`` draws at its default visibility."""
+    return node.children if VisibilityLevel.DETAIL < node.blackbox_level else []
+
+
 def _dot_names(root: Behaviour) -> Iterator[tuple[Behaviour, str]]:
-    """Each node and its name in ``py_trees.display.dot_tree``'s graph: the node's name
-    with ``*`` added until it is unique, depth first (dot_tree's own naming, which it
-    does not return)."""
+    """Each node ``py_trees.display.dot_tree`` draws and its name in the graph: the node's
+    name with ``*`` added until it is unique, depth first (dot_tree's own naming, which
+    it does not return)."""
     names: set[str] = {root.name}
     yield root, root.name
-    stack = [iter(root.children)]
+    stack = [iter(_shown_children(root))]
     while stack:
         child = next(stack[-1], None)
         if child is None:
@@ -75,7 +80,7 @@ def _dot_names(root: Behaviour) -> Iterator[tuple[Behaviour, str]]:
             name += "*"
         names.add(name)
         yield child, name
-        stack.append(iter(child.children))
+        stack.append(iter(_shown_children(child)))
 
 
 def dot_graph(root: Behaviour, statuses: Statuses | None = None) -> pydot.Dot:
@@ -86,7 +91,9 @@ def dot_graph(root: Behaviour, statuses: Statuses | None = None) -> pydot.Dot:
     with _showing(root, statuses):
         for node, name in _dot_names(root):
             colour = STATUS_COLOURS.get(node.status)
-            found = graph.get_node(name)
+            # pydot's own name for it (a ':' starts a port); 'node', 'graph' and 'edge' name
+            # the graph's defaults there, not a node.
+            found = [] if name in ("node", "graph", "edge") else graph.get_node(pydot.Node(name).get_name())
             if colour and found:
                 found[0].set("color", colour)
                 found[0].set("penwidth", "3")

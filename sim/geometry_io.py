@@ -128,6 +128,8 @@ def _why(err: Exception, fmt: str) -> str:
     if isinstance(err, ET.ParseError) and getattr(err, "position", None):
         line, column = err.position
         return f"not well-formed XML at line {line}, column {column + 1}"
+    if isinstance(err, OSError) and err.strerror:
+        return err.strerror.lower()
     return f"a broken file, or not a {fmt} file ({type(err).__name__} in its reader)"
 
 

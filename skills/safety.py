@@ -66,6 +66,7 @@ class BudgetElapsed(Skill):
     once the budget has elapsed; FAILURE while it has not, or when no budget is set.
     """
 
+    AGENT = None
     INPUT_PORTS = {
         "time_budget_s": PortInformation(float, required=False, description="the budget (s); null: none"),
         "budget_start_s": PortInformation(float, required=False, description="sim time the budget started at (s)"),

@@ -169,10 +169,6 @@ def cohort_figures(events: list[dict[str, Any]], robots: list[str], hub: Any) ->
         return sum(1 for e in events if e["event"] == event and e.get("agent") == robot
                    and all(e.get(k) == v for k, v in match.items()))
 
-    def frontiers(robot: str) -> int:
-        return sum(1 for e in events if e["event"] == "cohort_assignment_received" and e.get("agent") == robot
-                   and e.get("frontier") is not None)
-
     received = {r: 0 for r in robots}
     if hub is not None:
         for robot, _ in hub.submaps:
@@ -180,7 +176,9 @@ def cohort_figures(events: list[dict[str, Any]], robots: list[str], hub: Any) ->
     per_robot = {r: {"submaps_sent": count("cohort_submap_sent", r), "submaps_received": received.get(r, 0),
                      "calls": count("cohort_call", r), "calls_out_of_reach": count("cohort_call", r, reached=False),
                      "calls_unanswered": count("cohort_call_unanswered", r),
-                     "assignments": count("cohort_assignment_received", r), "frontiers_received": frontiers(r),
+                     "assignments": count("cohort_assignment_received", r),
+                     "frontiers_received": count("cohort_assignment_received", r)
+                     - count("cohort_assignment_received", r, frontier=None),
                      "extra_explorations": count("cohort_extra_exploration", r),
                      "lost_link_backtracks": count("cohort_backtrack", r),
                      "links_regained_on_the_way": count("cohort_link_regained", r)}

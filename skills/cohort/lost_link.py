@@ -28,6 +28,7 @@ class CohortTimer(Skill):
     Returns RUNNING until the span has passed since it was entered, then SUCCESS.
     """
 
+    AGENT = None
     PARAMS = {"span": Param(str, "period_s", "which COHORT time: T_C (period_s) or T_C^e (extra_explore_s)",
                             choices=SPANS)}
 
@@ -58,6 +59,7 @@ class ExplorationOver(Skill):
     SUCCESS when over, else FAILURE.
     """
 
+    AGENT = None
     INPUT_PORTS = {
         "homing_due": PortInformation(bool, required=False, description="GBPlanner2 calls for homing"),
         "exploration_complete": PortInformation(bool, required=False, description="GBPlanner2 found nothing left"),
@@ -132,6 +134,7 @@ class ReturnToLinkPoint(GoTo):
 
     def arrived(self) -> Status:
         if self.regained:
+            self.regained = False
             self.event("cohort_link_regained", at=xyz(self.robot.position, 2), to=xyz(self.goal, 2))
             return Status.SUCCESS
         ok = linked(self.robot.radio, self.p["ping_attempts"])

@@ -4,6 +4,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import py_trees
+import pytest
 from delve.executive.agent import Agent
 from delve.executive.tree_loader import load_tree
 from delve.skills.base import AgentContext
@@ -16,8 +17,14 @@ class Clock:
     now_s = 0.0
 
 
-def test_a_stopped_tree_keeps_the_statuses_it_had_and_its_final_status():
+@pytest.fixture(autouse=True)
+def blackboard():
     py_trees.blackboard.Blackboard.clear()
+    yield
+    py_trees.blackboard.Blackboard.clear()
+
+
+def test_a_stopped_tree_keeps_the_statuses_it_had_and_its_final_status():
     ctx = AgentContext(name="r1", namespace="/r1", clock=Clock(), log=lambda *a, **k: None)
     agent = Agent("r1", load_tree(TREES / "timed.yaml", ctx), 1.0, ctx)
     assert agent.tick_if_due(0.0) and not agent.tick_if_due(0.5)   # one tick a period
@@ -27,4 +34,3 @@ def test_a_stopped_tree_keeps_the_statuses_it_had_and_its_final_status():
     assert agent.root.status == Status.INVALID and agent.final_status == Status.RUNNING
     assert agent.stopped_statuses[agent.root.id] == Status.RUNNING
     assert list(agent.stopped_statuses.values()).count(Status.INVALID) == 1   # the note, never ticked
-    py_trees.blackboard.Blackboard.clear()

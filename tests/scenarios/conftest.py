@@ -16,6 +16,7 @@ def run_scenario(path: Path, out: Path | None = None, *, endurance_s: dict[str, 
     """Run a scenario, its robots' endurances replaced by ``endurance_s`` (by robot name) to
     keep a test short; write its outputs into ``out`` when given. Returns the mission and report."""
     scenario = load_scenario(path)
+    assert set(endurance_s or ()) <= {r.name for r in scenario.robots}, "endurance_s names an unknown robot"
     for robot in scenario.robots:
         robot.endurance_s = (endurance_s or {}).get(robot.name, robot.endurance_s)
     mission = Mission(scenario, **kw)

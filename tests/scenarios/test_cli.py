@@ -64,3 +64,10 @@ def test_validate_prints_the_world_warnings_and_start_errors(tmp_path, capsys):
     out, err = capsys.readouterr()
     assert out == f"ok: {good}\n"
     assert f"{bad}:12: robot 'anymal': start pose [2.0, 2.1, 1.0] is inside rock (nearest free floor: [" in err
+
+
+def test_render_formats_are_the_renderer_s():
+    from delve.executive.cli import RENDER_FORMATS
+    from delve.executive.render import FORMATS
+
+    assert set(RENDER_FORMATS) == set(FORMATS)
