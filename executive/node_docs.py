@@ -90,7 +90,9 @@ def reference_markdown(registry: Registry | None = None) -> str:
             cls = t.cls if t.cls is not None and t.kind == "skill" else None
             doc = inspect.cleandoc(cls.__doc__ or "") if cls is not None else t.doc
 
-            out += [f"### {name}", "", f"*{kind}, {kids}*", "", doc, ""]
+            agent = {"robot": ", in a robot's tree", "base": ", in the base station's tree"}.get(
+                getattr(cls, "AGENT", None), ", in any agent's tree" if cls is not None else "")
+            out += [f"### {name}", "", f"*{kind}, {kids}{agent}*", "", doc, ""]
             rows = [(slot, "subtree", "required", d) for slot, d in t.subtrees.items()]
             rows += [(p, getattr(s.type, "__name__", "any"), "required" if s.required else f"`{s.default!r}`", s.doc)
                      for p, s in t.params.items()]
