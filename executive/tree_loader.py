@@ -123,10 +123,25 @@ class _TreeBuilder:
         self.registry = registry
         self.root_dir = os.path.dirname(os.path.realpath(root_file)) if root_file else os.getcwd()
         self.roots = allowed_include_roots(root_file, include_path)
+        #: Where a relative include not found beside its file is looked for next, in order.
+        self.search = tuple(dict.fromkeys([*(os.path.realpath(p) for p in include_path), os.path.realpath(TREES_DIR)]))
         self.depth = 0
         self.frames: list[_RemapFrame] = []
 
     # ---------------------------------------------------------------- files
+    def _find(self, base: str, target: str) -> str:
+        """The file an include names: ``target`` beside the including file, or, when it is
+        not there and is relative, in the first of :attr:`search` that holds it (so a
+        shipped tree copied elsewhere still finds the shipped subtrees)."""
+        path = os.path.normpath(os.path.join(base, target))
+        if os.path.isabs(target) or os.path.exists(path):
+            return path
+        for root in self.search:
+            found = os.path.normpath(os.path.join(root, target))
+            if path_inside(os.path.realpath(found), root) and os.path.isfile(found):
+                return found
+        return path
+
 
     def chain_name(self, real: str) -> str:
         rel = os.path.relpath(real, self.root_dir)
@@ -211,7 +226,7 @@ class _TreeBuilder:
                     raise DelveError(f"remap {what} {short_repr(text)} is not a blackboard key ({KEY_RULE})", file,
                                      line_hint or site.line_of("remap"), name)
         base = os.path.dirname(file) if file else ""
-        path = os.path.normpath(os.path.join(base, target))
+        path = self._find(base, target)
         real = os.path.realpath(path)
         if not any(path_inside(real, root) for root in self.roots):
             folders = ", ".join([f"the tree's folder {os.path.join(display_path(self.roots[0]), '')}",
@@ -223,8 +238,8 @@ class _TreeBuilder:
             site.fail(f"include cycle: {' -> '.join(names)}", "include")
         problem = file_problem(path)
         if problem:
-            site.fail(f"included file {problem}: {short_repr(target)} (relative to {display_path(base or '.')})",
-                      "include")
+            site.fail(f"included file {problem}: {short_repr(target)} (relative to {display_path(base or '.')}, "
+                      "the --include-path folders and the shipped trees)", "include")
         frame = _RemapFrame(dict(inner))
         self.frames.append(frame)
         try:

@@ -147,6 +147,23 @@ def test_includes_resolve_relative_to_the_including_file(tmp_path, monkeypatch):
     assert root.decorated.name == "Leaf"
 
 
+def test_a_relative_include_not_beside_its_file_is_looked_for_in_the_include_path_then_the_shipped_trees(
+        tmp_path):
+    from delve import TREES_DIR
+
+    mine = write(tmp_path, "mine/cohort_robot.yaml", (TREES_DIR / "cohort_robot.yaml").read_text())
+    assert check_tree(mine)   # a shipped tree copied to edit still finds the shipped subtrees
+    write(tmp_path, "lib/subtrees/watchdog.yaml", "type: Success\nname: My watchdog\n")
+    names = {n.name for n in load_tree(mine, make_ctx(), include_path=[tmp_path / "lib"]).iterate()}
+    assert "My watchdog" in names   # the --include-path folder before the shipped trees
+    write(tmp_path, "mine/subtrees/watchdog.yaml", "type: Success\nname: Beside\n")
+    names = {n.name for n in load_tree(mine, make_ctx(), include_path=[tmp_path / "lib"]).iterate()}
+    assert "Beside" in names and "My watchdog" not in names   # beside the file first
+    write(tmp_path, "mine/up.yaml", "type: Inverter\nchild: {include: ../subtrees/watchdog.yaml}\n")
+    with pytest.raises(DelveError, match="outside the allowed folders"):
+        check_tree(tmp_path / "mine" / "up.yaml")   # the search never leaves a folder
+
+
 def test_errors_in_included_files_name_that_file(tmp_path):
     write(tmp_path, "sub.yaml", "type: Sequence\nchildren:\n  - type: Timer\n    duration_s: -2\n")
     path = write(tmp_path, "root.yaml", "type: Inverter\nchild:\n  include: sub.yaml\n")
