@@ -242,8 +242,8 @@ def one_line(capsys) -> str:
     return err
 
 
-def test_render_of_a_scenario_says_it_is_one(capsys):
-    assert main(["render", str(DATA / "malformed" / "scenario_as_tree.yaml")]) == 2
+def test_render_of_a_scenario_says_it_is_one(capsys, tmp_path):
+    assert main(["render", str(DATA / "malformed" / "scenario_as_tree.yaml"), "--out", str(tmp_path / "t.txt")]) == 2
     assert "scenario_as_tree.yaml is a scenario, not a tree" in one_line(capsys)
 
 
