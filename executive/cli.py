@@ -42,7 +42,8 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("--duration-s", type=float, help="override the scenario's duration (sim seconds)")
     run.add_argument("--quiet", action="store_true", help="no progress bar")
     val = sub.add_parser("validate", help="check tree and scenario files")
-    val.add_argument("files", type=Path, nargs="*", help="tree and scenario files (each is told apart by its keys)")
+    val.add_argument("files", type=Path, nargs="*",
+                     help="tree and scenario files (each is told apart by its keys)")
     val.add_argument("--shipped", action="store_true", help="also check every shipped tree and scenario")
     ren = sub.add_parser("render", help="draw a tree file")
     ren.add_argument("tree", type=Path, help="a tree file (YAML)")

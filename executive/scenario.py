@@ -169,7 +169,8 @@ def _schema_error(err: jsonschema.ValidationError, doc: Any, path: Path) -> Delv
         return DelveError("world: give one of 'generator', 'mesh' or 'network'", path, line)
     if err.validator == "enum":
         choices = ", ".join(map(repr, err.validator_value))
-        hint = did_you_mean(err.instance, map(str, err.validator_value)) if isinstance(err.instance, str) else ""
+        hint = did_you_mean(err.instance, map(str, err.validator_value)) \
+            if isinstance(err.instance, str) else ""
         return DelveError(f"{where}: {short_repr(err.instance)} is not one of {choices}{hint}", path, line)
     message = err.message
     shown = repr(err.instance)
@@ -304,7 +305,8 @@ def _check_agent_kind(types: set[type], kind: str, what: str, path: Path, line: 
     """A behaviour that belongs in the other kind of agent's tree (``AGENT`` of a
     skill: "robot" or "base") in the tree of a ``kind`` agent: a mistake at its
     ``tree:`` line (built, it would fail at its first tick)."""
-    wrong = sorted(getattr(c, "TYPE_NAME", c.__name__) for c in types if getattr(c, "AGENT", None) not in (None, kind))
+    wrong = sorted(getattr(c, "TYPE_NAME", c.__name__) for c in types
+                   if getattr(c, "AGENT", None) not in (None, kind))
     if wrong:
         why = "which needs a robot (the base station has none)" if kind == "base" else \
             "a behaviour of the base station (it belongs in base_station: tree:)"

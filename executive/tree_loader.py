@@ -124,7 +124,8 @@ class _TreeBuilder:
         self.root_dir = os.path.dirname(os.path.realpath(root_file)) if root_file else os.getcwd()
         self.roots = allowed_include_roots(root_file, include_path)
         #: Where a relative include not found beside its file is looked for next, in order.
-        self.search = tuple(dict.fromkeys([*(os.path.realpath(p) for p in include_path), os.path.realpath(TREES_DIR)]))
+        self.search = tuple(dict.fromkeys([*(os.path.realpath(p) for p in include_path),
+                                           os.path.realpath(TREES_DIR)]))
         self.depth = 0
         self.frames: list[_RemapFrame] = []
 

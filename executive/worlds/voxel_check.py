@@ -72,14 +72,16 @@ def place_starts(scenario: "Scenario", world: World) -> list[StartPlacement]:
     return out
 
 
-def _default_start(world: World, defaults: list[np.ndarray], i: int, used: set[int], platform: Platform) -> int | None:
+def _default_start(world: World, defaults: list[np.ndarray], i: int, used: set[int],
+                   platform: Platform) -> int | None:
     """The default start of robot #``i`` (an index into ``defaults``, marked ``used``):
     the first from the ``i``-th on that no robot before took and, for an aerial robot,
     where it hovers clear of rock (:func:`~delve.sim.start_landing.hover_clear`; else
     the first not taken, with a warning); None when none is left."""
     left = [j for j in range(i, len(defaults)) if j not in used]
     body = np.array([0.0, 0.0, platform.body_height_m])
-    j = next((j for j in left if not platform.aerial or hover_clear(world, defaults[j] + body, platform.radius_m)),
+    r = platform.radius_m
+    j = next((j for j in left if not platform.aerial or hover_clear(world, defaults[j] + body, r)),
              left[0] if left else None)
     if j is not None:
         used.add(j)

@@ -197,7 +197,8 @@ def _draw_band(ax: Any, mission: "Mission", band: HeightBand, grids: tuple[np.nd
     first = next((i for i, p in enumerate(links) if len(p)), 0 if band is ALL_HEIGHTS else None)
     for i, pos in enumerate(links):
         # Gold with a dark edge: no robot's path has that colour.
-        ax.plot(pos[:, 0], pos[:, 1], "o", ms=3.5, mfc="gold", mec="0.2", mew=0.5, zorder=1.9,   # under the paths
+        ax.plot(pos[:, 0], pos[:, 1], "o", ms=3.5, mfc="gold", mec="0.2", mew=0.5,
+                zorder=1.9,   # under the paths
                 label="radio link to base" if i == first else None)
     if band.holds(mission.base_position).all():
         ax.plot(*mission.base_position[:2], "k^", ms=9, label="base station")
