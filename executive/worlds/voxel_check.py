@@ -27,6 +27,8 @@ START_OFFSETS_M = [(0, 0), (1.2, 0), (-1.2, 0), (0, 1.2), (0, -1.2), (2.4, 0), (
                    (-1.2, 2.4), (1.2, -2.4), (-1.2, -2.4), (0, 3.6), (0, -3.6)]
 #: A default start needs free space this far above it.
 DEFAULT_START_CLEAR_M = 0.3
+#: A default start closer than this (horizontally) to a given one is not used.
+GIVEN_START_SPACING_M = 1.0
 
 
 @dataclass
@@ -49,7 +51,9 @@ def place_starts(scenario: "Scenario", world: World) -> list[StartPlacement]:
     defaults = [np.asarray(world.start, float) + np.array([dx, dy, 0.0]) for dx, dy in START_OFFSETS_M]
     lift = np.array([0.0, 0.0, DEFAULT_START_CLEAR_M])
     defaults = [p for p in defaults if world.is_free((p + lift)[None])[0]]
-    used: set[int] = set()
+    given = [np.asarray(s.start, float) for s in scenario.robots if s.start is not None]
+    used = {j for j, p in enumerate(defaults)
+            if any(np.hypot(*(p - g)[:2]) < GIVEN_START_SPACING_M for g in given)}
     out = []
     for i, spec in enumerate(scenario.robots):
         platform = PLATFORMS[spec.platform]

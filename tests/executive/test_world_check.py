@@ -174,3 +174,18 @@ def test_a_default_aerial_start_keeps_its_radius_and_a_voxel_from_rock(tmp_path)
     assert clearance_m(world, aerial[1] + [0.0, 0.0, 1.0], 2.0) >= 0.8
     _, legged = starts("legged")
     np.testing.assert_allclose(legged[1][:2], second[:2])
+
+
+def test_a_default_start_is_never_where_a_robot_was_given_its_start(tmp_path):
+    from delve.executive.worlds.voxel_check import place_starts
+
+    path = tmp_path / "s.yaml"
+    tree = TREES_DIR / "frontier_explorer.yaml"
+    path.write_text("name: s\nseed: 1\nworld: {generator: tunnel_network, total_length_m: 120, loops: 1}\n"
+                    "robots:\n"
+                    f"  - {{name: a, platform: legged, tree: {tree}, start: [1.2, 0.0, 0.0]}}\n"
+                    f"  - {{name: b, platform: legged, tree: {tree}}}\n")
+    scenario = load_scenario(path)
+    world = scenario.build_world()
+    a, b = (p.landing.start for p in place_starts(scenario, world))
+    assert np.hypot(*(a - b)[:2]) >= 1.0   # b's own place (1.2 m along x) is a's start: it takes the next
