@@ -2,8 +2,8 @@
 from __future__ import annotations
 
 from pathlib import Path
+from types import SimpleNamespace
 
-import py_trees
 import pytest
 from delve.executive.agent import Agent
 from delve.executive.tree_loader import load_tree
@@ -13,19 +13,9 @@ from py_trees.common import Status
 TREES = Path(__file__).resolve().parent.parent / "data" / "trees"
 
 
-class Clock:
-    now_s = 0.0
-
-
-@pytest.fixture(autouse=True)
-def blackboard():
-    py_trees.blackboard.Blackboard.clear()
-    yield
-    py_trees.blackboard.Blackboard.clear()
-
-
+@pytest.mark.usefixtures("clean_blackboard")
 def test_a_stopped_tree_keeps_the_statuses_it_had_and_its_final_status():
-    ctx = AgentContext(name="r1", namespace="/r1", clock=Clock(), log=lambda *a, **k: None)
+    ctx = AgentContext(name="r1", namespace="/r1", clock=SimpleNamespace(now_s=0.0), log=lambda *a, **k: None)
     agent = Agent("r1", load_tree(TREES / "timed.yaml", ctx), 1.0, ctx)
     assert agent.tick_if_due(0.0) and not agent.tick_if_due(0.5)   # one tick a period
     assert agent.final_status == Status.RUNNING and agent.stopped_statuses is None

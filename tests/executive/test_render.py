@@ -20,10 +20,8 @@ class Clock:
 
 
 @pytest.fixture(autouse=True)
-def blackboard():
-    py_trees.blackboard.Blackboard.clear()
-    yield
-    py_trees.blackboard.Blackboard.clear()
+def blackboard(clean_blackboard):
+    """Every test here starts and ends with an empty blackboard."""
 
 
 def timed_tree(ticks_at_s: tuple[float, ...]) -> py_trees.behaviour.Behaviour:
