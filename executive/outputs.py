@@ -14,6 +14,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from .colours import robot_colour  # noqa: E402
 from .render import render_tree  # noqa: E402
 from .runner import Mission  # noqa: E402
 from .teams import wall_clock_fields  # noqa: E402
@@ -125,16 +126,15 @@ def write_outputs(mission: Mission, out: Path, wall_time_s: float) -> dict[str, 
 
 def plot_coverage(mission: Mission, path: Path, ylabel: str) -> None:
     """Explored fraction over sim time: team and base station (black), robots (each in
-    its colour on map.png: the colour cycle's, in the scenario's order)."""
+    its :func:`robot_colour`, as on map.png)."""
     s = mission.state.samples
     t = np.array([x.t for x in s]) / 60.0
     fig, ax = plt.subplots(figsize=(7, 4))
     ax.plot(t, [x.team for x in s], lw=2, color="black", label="team")
     ax.plot(t, [x.base for x in s], lw=2, ls="--", color="0.45", label="known at base station")
     if len(mission.robots) > 1:
-        colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
         for i, name in enumerate(mission.robots):
-            ax.plot(t, [x.robots[name] for x in s], lw=1, color=colours[i % len(colours)], label=name)
+            ax.plot(t, [x.robots[name] for x in s], lw=1, color=robot_colour(i), label=name)
     ax.set_xlabel("sim time (min)")
     ax.set_ylabel(ylabel)
     ax.set_ylim(0, 1.02)

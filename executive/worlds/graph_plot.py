@@ -10,6 +10,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from ..colours import robot_colour  # noqa: E402
+
 if TYPE_CHECKING:
     from ..runner import Mission
 
@@ -31,10 +33,9 @@ def plot_graph_map(mission: "Mission", at_base: set[str], path: Path) -> None:
                                 (team & at_base, dict(color="tab:blue", ms=6), "known at base station")):
         pts = np.array([xyz[s] for s in sorted(group)]).reshape(-1, 3)
         ax.plot(pts[:, 0], pts[:, 1], "o", label=label, zorder=2, **style)
-    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     for i, (name, robot) in enumerate(mission.robots.items()):
         trail = robot.traversed_path
-        ax.plot(trail[:, 0], trail[:, 1], "-", lw=1, alpha=0.6, color=colours[i % len(colours)], zorder=3,
+        ax.plot(trail[:, 0], trail[:, 1], "-", lw=1, alpha=0.6, color=robot_colour(i), zorder=3,
                 label=name if len(mission.robots) <= 10 else None)
     ax.plot(*mission.base_position[:2], "k^", ms=10, label="base station", zorder=4)
     ax.set_aspect("equal")

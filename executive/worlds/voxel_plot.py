@@ -14,6 +14,7 @@ from scipy.ndimage import binary_dilation, find_objects, label, maximum_filter1d
 from ...planners.frontier import FRONTIER_DEPTH, frontier_voxels  # noqa: E402
 from ...planners.navgraph import FACES, Voxels  # noqa: E402
 from ...planners.occupancy import OCCUPIED, UNKNOWN, Grid  # noqa: E402
+from ..colours import robot_colour  # noqa: E402
 from .height_bands import ALL_HEIGHTS, HeightBand, height_bands  # noqa: E402
 
 if TYPE_CHECKING:
@@ -175,7 +176,6 @@ def _draw_band(ax: Any, mission: "Mission", band: HeightBand, grids: tuple[np.nd
         if where.any():
             ax.fill([], [], color=rgb, label=label)   # a legend entry for the fill
     ax.imshow(img, origin="lower", extent=extent, interpolation="nearest")
-    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     for i, (name, robot) in enumerate(mission.robots.items()):
         trail = np.array(robot.traversed_path, float).reshape(-1, 3)
         inside = band.holds(trail)
@@ -186,7 +186,7 @@ def _draw_band(ax: Any, mission: "Mission", band: HeightBand, grids: tuple[np.nd
         # A flying robot's path dashed and above the ground robots' solid ones: where it flew
         # over a ground robot's path, that path shows between its dashes.
         ax.plot(trail[:, 0], trail[:, 1], ls=(0, (4, 2.5)) if aerial else "-", lw=1.3,
-                color=colours[i % len(colours)], zorder=2.2 if aerial else 2.0,
+                color=robot_colour(i), zorder=2.2 if aerial else 2.0,
                 label=f"{name} path (flying)" if aerial else f"{name} path")
     ax.plot(left[:, 0], left[:, 1], ".", ms=2, color="red", zorder=3,
             label=f"frontiers left: where the seen area opens\nonto unseen ground (edges >= {MIN_EDGE_M:g} m)"

@@ -103,12 +103,10 @@ class ReturnToLinkPoint(GoTo):
         super().__init__(name, ctx, remap, goal=None, **params)
         self.points: list[np.ndarray] = []
         self.next_ping_s = float("inf")
-        self.regained = False
 
     def initialise(self) -> None:
         super().initialise()
         self.next_ping_s = self.ctx.clock.now_s + self.p["ping_every_s"]
-        self.regained = False
         r = self.robot
         self.points = [r.home.copy(), *(np.asarray(p, float) for p in self.read("cohort_link_points") or [])]
         self.goal = self.points.pop()
@@ -127,14 +125,13 @@ class ReturnToLinkPoint(GoTo):
         """At the link point, or the hub answered this tick's ping on the way."""
         if super().reached():
             return True
-        if self.ctx.clock.now_s >= self.next_ping_s:
-            self.next_ping_s = self.ctx.clock.now_s + self.p["ping_every_s"]
-            self.regained = linked(self.robot.radio, 1)
-        return self.regained
+        if self.ctx.clock.now_s < self.next_ping_s:
+            return False
+        self.next_ping_s = self.ctx.clock.now_s + self.p["ping_every_s"]
+        return linked(self.robot.radio, 1)
 
     def arrived(self) -> Status:
-        if self.regained:
-            self.regained = False
+        if not super().reached():   # short of the point: a ping on the way was answered
             self.event("cohort_link_regained", at=xyz(self.robot.position, 2), to=xyz(self.goal, 2))
             return Status.SUCCESS
         ok = linked(self.robot.radio, self.p["ping_attempts"])
