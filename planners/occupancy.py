@@ -9,6 +9,7 @@ A grid is an int8 array (nx, ny, nz) with values :data:`UNKNOWN`, :data:`FREE` a
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 
@@ -24,11 +25,16 @@ class Grid:
     occupancy: np.ndarray
     origin: np.ndarray
     voxel_size_m: float
-    free: np.ndarray | None = None
+    #: The FREE voxels' flat indices when the map keeps them: an array, or a function
+    #: that gives it (asked only by the planners that need it, since bringing a large
+    #: map's list up to date costs milliseconds).
+    free: np.ndarray | Callable[[], np.ndarray] | None = None
 
     def free_voxels(self) -> np.ndarray:
         """Flat indices of the FREE voxels: ``free`` when the map keeps them, else
         found by scanning the grid."""
+        if callable(self.free):
+            return self.free()
         if self.free is not None:
             return self.free
         return np.flatnonzero(self.occupancy.reshape(-1) == FREE)

@@ -55,7 +55,7 @@ class Navigator:
 
     def grid(self) -> Grid:
         m = self.robot.onboard_map
-        return Grid(m.occupancy, m.origin, m.voxel_size_m, m.free_voxels())
+        return Grid(m.occupancy, m.origin, m.voxel_size_m, m.free_voxels)
 
 
     def graph(self, force: bool = False) -> NavGraph:

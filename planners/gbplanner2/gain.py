@@ -218,13 +218,21 @@ class _RayTables:
     offsets: np.ndarray  # (directions, k_max) flat index offsets from a voxel centre
 
 
-def _canonical_azimuth(config: GBPlannerConfig, ring_azimuth_rad: float) -> float:
-    """The ring azimuth modulo the ray spacing, on a grid of 1/interleave of it: rings
-    turned by a whole spacing are the same rays, so few tables serve all calls."""
+def ring_phase(config: GBPlannerConfig, ring_azimuth_rad: float | np.ndarray) -> np.ndarray:
+    """The ring azimuth modulo the ray spacing, in 1/interleave of it (0 to interleave
+    - 1): rings turned by a whole spacing are the same rays, so a ring with azimuth a is
+    the ring of azimuth 0 at ``ray_phase=ring_phase(config, a)`` of
+    :func:`volumetric_gain`, and rays of several azimuths go in one call."""
     ring = sensor_rays(config).ring_bins
-    sub = 2.0 * math.pi / ring / int(config.gain_ray_interleave)
-    q = round(float(ring_azimuth_rad) / sub) % int(config.gain_ray_interleave)
-    return q * sub
+    m = int(config.gain_ray_interleave)
+    sub = 2.0 * math.pi / ring / m
+    return np.round(np.asarray(ring_azimuth_rad, float) / sub).astype(np.int64) % m
+
+
+def _canonical_azimuth(config: GBPlannerConfig, ring_azimuth_rad: float) -> float:
+    """:func:`ring_phase` as an azimuth: few ray tables serve all calls."""
+    ring = sensor_rays(config).ring_bins
+    return int(ring_phase(config, ring_azimuth_rad)) * (2.0 * math.pi / ring / int(config.gain_ray_interleave))
 
 
 @lru_cache(maxsize=16)

@@ -38,7 +38,7 @@ from scipy.spatial import cKDTree
 from ..geometry import path_length
 from ..occupancy import OCCUPIED, Grid
 from .config import GBPlannerConfig
-from .gain import ring_azimuth, volumetric_gain
+from .gain import ring_azimuth, ring_phase, volumetric_gain
 from .local_map import LocalMap
 from .local_planner import LocalPlanResult
 from .path_improvement import shortcut_path
@@ -300,12 +300,9 @@ class GlobalPlanner:
             pos = pos[sel]
         if not ids:
             return
-        # One ray cast per ring alignment (frontiers keep the one they were found with).
-        g = np.zeros(len(ids))
+        # Each frontier keeps the ring alignment it was found with: one call for all.
         az = np.array([self.frontiers[i].ring_azimuth_rad for i in ids])
-        for a in np.unique(az):
-            sel = az == a
-            g[sel] = volumetric_gain(grid, pos[sel], self.config, 0.0, float(a))
+        g = volumetric_gain(grid, pos, self.config, 0.0, 0.0, ray_phase=ring_phase(self.config, az))
         for i, gain in zip(ids, g):
             if gain < self.config.frontier_gain_min_m3:
                 del self.frontiers[i]

@@ -9,6 +9,7 @@ from delve.planners.gbplanner2.gain import (
     cluster_vertices,
     compute_vertex_gains,
     exploration_gains,
+    ring_phase,
     sensor_rays,
     volumetric_gain,
 )
@@ -89,6 +90,19 @@ def test_limited_horizontal_fov_depends_on_heading():
     p = np.array([[10.0, 10.0, 2.0]] * 2)
     toward, away = volumetric_gain(grid, p, cfg, np.array([0.0, math.pi]))
     assert toward > 0 and away == 0
+
+
+def test_rings_of_several_azimuths_in_one_call_by_their_phase():
+    g, a, b = s.straight_tunnel(length_m=40, mapped_to_m=26, yaw_deg=30.0)
+    u = (b - a) / np.linalg.norm(b - a)
+    pts = a + np.outer([4.0, 12.0, 20.0, 23.0], u) + np.array([0, 0, 0.5])
+    az = np.array([0.0, 0.7, 2.0, -1.3])
+    one_by_one = [volumetric_gain(g, p[None], CFG, 0.0, float(x))[0] for p, x in zip(pts, az)]
+    phases = ring_phase(CFG, az)
+    assert len(set(phases.tolist())) > 1
+    together = volumetric_gain(g, pts, CFG, 0.0, 0.0, ray_phase=phases)
+    assert np.allclose(together, one_by_one, rtol=1e-6)
+    assert together[3] > together[0] > 0
 
 
 def _star_graph(hanging_last=False):
