@@ -2,6 +2,7 @@
 voxel maps, a radio with path loss and breadcrumbs, coverage of the free volume."""
 from __future__ import annotations
 
+import os
 from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Mapping
@@ -74,7 +75,7 @@ class VoxelBackend(WorldBackend):
                 if problem and problem != "is a directory":  # a folder: a Gazebo model
                     raise DelveError(f"mesh file {problem}: {short_repr(str(given))[1:-1]}", scenario.path,
                                      where.key_line("mesh"))
-                mesh = given.resolve()
+                mesh = Path(os.path.abspath(given))   # a symbolic link keeps the name the user gave
                 spec.pop("seed", None)
                 if "trajectory" in spec:
                     given = spec["trajectory"]
@@ -82,7 +83,7 @@ class VoxelBackend(WorldBackend):
                     if problem:
                         raise DelveError(f"trajectory file {problem}: {short_repr(given)[1:-1]}", scenario.path,
                                          where.key_line("trajectory"))
-                    spec["trajectory"] = (scenario.path.parent / given).resolve()
+                    spec["trajectory"] = Path(os.path.abspath(scenario.path.parent / given))
                 seeds = [r.start for r in scenario.robots if r.start is not None]
                 return from_file(mesh, seeds=seeds, **spec)
             generate = cls.generators()[spec.pop("generator")]
