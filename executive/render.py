@@ -105,6 +105,17 @@ def dot_graph(root: Behaviour, statuses: Statuses | None = None) -> pydot.Dot:
     return graph
 
 
+def _ascii_memory_mark(graph: pydot.Dot) -> None:
+    """Label composites with memory by py_trees' ASCII mark ("M") instead of its Ⓜ
+    (U+24C2): graphviz draws a PNG with the machine's fonts, which often lack it (DejaVu
+    has none) and show a box there; an SVG is drawn with the viewer's fonts."""
+    memory = py_trees.display.unicode_symbols["memory"]
+    for node in graph.get_nodes():
+        label = node.get("label")
+        if isinstance(label, str) and memory in label:
+            node.set("label", label.replace(memory, py_trees.display.ascii_symbols["memory"]))
+
+
 def render_tree(root: Behaviour, fmt: str, out_path: str | os.PathLike[str],
                 statuses: Statuses | None = None) -> Path:
     """Write the tree under ``root`` to ``out_path`` as ``fmt`` and return the path.
@@ -125,6 +136,8 @@ def render_tree(root: Behaviour, fmt: str, out_path: str | os.PathLike[str],
         out.write_text(text_tree(root, statuses), encoding="utf-8")
         return out
     graph = dot_graph(root, statuses)
+    if fmt == "png":
+        _ascii_memory_mark(graph)
     try:
         graph.write(str(out), format=FORMATS[fmt])
     except FileNotFoundError as err:

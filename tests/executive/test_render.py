@@ -8,7 +8,7 @@ import py_trees
 import pytest
 from py_trees.common import Status
 from delve.executive.errors import DelveError
-from delve.executive.render import dot_graph, render_tree, text_tree
+from delve.executive.render import _ascii_memory_mark, dot_graph, render_tree, text_tree
 from delve.executive.tree_loader import load_tree
 from delve.skills.base import AgentContext
 
@@ -100,6 +100,16 @@ def test_dot_is_written_without_graphviz(ticked_tree, tmp_path):
 def test_graph_formats(ticked_tree, tmp_path, fmt, magic):
     out = render_tree(ticked_tree, fmt, tmp_path / f"tree.{fmt}")
     assert magic in out.read_bytes()[:400]
+
+
+def test_a_png_marks_memory_in_ascii_the_other_formats_as_py_trees_does():
+    steps = py_trees.composites.Sequence("Steps", memory=True,
+                                         children=[py_trees.behaviours.Success("Step")])
+    graph = dot_graph(steps)
+    memory = py_trees.display.unicode_symbols["memory"]
+    assert memory in graph.get_node("Steps")[0].get("label")
+    _ascii_memory_mark(graph)
+    assert graph.get_node("Steps")[0].get("label").strip('"').startswith("M Steps")
 
 
 def test_unknown_format(ticked_tree, tmp_path):
