@@ -49,6 +49,15 @@ class PointCache:
         self._s1 = np.zeros((0, 3))
         self._s2 = np.zeros((0, 3, 3))
         self._ray = np.zeros((0, 3))
+        #: Each voxel's eigen-decomposition of its covariance, kept between calls of
+        #: :meth:`cloud` and made again only where points came in since (``_stale``):
+        #: numpy decomposes a stack of 3x3 matrices one LAPACK call at a time.
+        self._lam = np.zeros((0, 3))
+        self._xi = np.zeros((0, 3, 3))
+        self._stale = np.zeros(0, dtype=bool)
+
+    def _columns(self) -> tuple[str, ...]:
+        return ("_keys", "_n", "_s1", "_s2", "_ray", "_lam", "_xi", "_stale")
 
     def __len__(self) -> int:
         return len(self._keys)
@@ -79,22 +88,22 @@ class PointCache:
         self._s1[at] += s1[old]
         self._s2[at] += s2[old]
         self._ray[at] = ray[old]
+        self._stale[at] = True
         new = ~old
         if new.any():
-            self._keys = np.concatenate([self._keys, keys[new]])
-            order = np.argsort(self._keys, kind="stable")
-            self._keys = self._keys[order]
-            self._n = np.concatenate([self._n, n[new]])[order]
-            self._s1 = np.concatenate([self._s1, s1[new]])[order]
-            self._s2 = np.concatenate([self._s2, s2[new]])[order]
-            self._ray = np.concatenate([self._ray, ray[new]])[order]
+            k = int(new.sum())
+            added = {"_keys": keys[new], "_n": n[new], "_s1": s1[new], "_s2": s2[new], "_ray": ray[new],
+                     "_lam": np.zeros((k, 3)), "_xi": np.zeros((k, 3, 3)), "_stale": np.ones(k, dtype=bool)}
+            order = np.argsort(np.concatenate([self._keys, keys[new]]), kind="stable")
+            for name in self._columns():
+                setattr(self, name, np.concatenate([getattr(self, name), added[name]])[order])
 
     def prune(self, agent: np.ndarray, radius_m: float) -> None:
         """Forget the voxels whose mean lies farther than ``radius_m`` from ``agent`` (the cache is
         limited in range)."""
         keep = np.linalg.norm(self.means() - np.asarray(agent, float), axis=1) <= radius_m
-        self._keys, self._n, self._s1, self._s2, self._ray = (
-            a[keep] for a in (self._keys, self._n, self._s1, self._s2, self._ray))
+        for name in self._columns():
+            setattr(self, name, getattr(self, name)[keep])
 
     def counts(self) -> np.ndarray:
         """(M,) points per voxel, by voxel key."""
@@ -126,7 +135,7 @@ class PointCache:
         mu = self.means()
         idx = np.flatnonzero(np.linalg.norm(mu - a, axis=1) <= params.d_max_m)
         mu = mu[idx]
-        lam, xi = np.linalg.eigh(self.covariances(idx))   # ascending eigenvalues
+        lam, xi = self._eigen(idx)   # ascending eigenvalues
         normal = xi[:, :, 0]
         normal *= np.where(np.einsum("ij,ij->i", normal, self._ray[idx]) > 0, -1.0, 1.0)[:, None]
         has_normal = self._n[idx] >= MIN_POINTS_FOR_NORMAL
@@ -138,6 +147,16 @@ class PointCache:
         axes = xi[near][:, :, 1:] * half[:, None, :]          # (n, 3, 2) scaled in-plane axes
         sub = mu[near][:, None, :] + np.einsum("kc,ndc->nkd", _KL, axes)
         return np.concatenate([mu[far], sub.reshape(-1, 3)])
+
+
+    def _eigen(self, idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``np.linalg.eigh`` of the covariances of the voxels ``idx``, from the kept ones where
+        no point came in since they were made."""
+        redo = idx[self._stale[idx]]
+        if len(redo):
+            self._lam[redo], self._xi[redo] = np.linalg.eigh(self.covariances(redo))
+            self._stale[redo] = False
+        return self._lam[idx], self._xi[idx]
 
 
 __all__ = ["MIN_POINTS_FOR_NORMAL", "PointCache"]

@@ -115,6 +115,11 @@ def gaussian_kl(means0: np.ndarray, covs0: np.ndarray, means1: np.ndarray, covs1
     return 0.5 * (trace + mahalanobis - 3 + logdet1[None, :] - logdet0[:, None])
 
 
+def _split(values: np.ndarray, frontiers: list[Frontier]) -> list[np.ndarray]:
+    """``values`` of the frontiers' points taken together, cut back into one array per frontier."""
+    return np.split(values, np.cumsum([len(f.points) for f in frontiers])[:-1])
+
+
 def _subset(f: Frontier, keep: np.ndarray) -> Frontier:
     return make_frontier(f.id, f.points[keep], f.normals[keep], f.areas[keep])
 
@@ -179,8 +184,9 @@ class SequentialFrontiers:
         changed_rest: list[Frontier] = []      # what is left of them (for the clustering)
         old = [self._frontiers[k] for k in sorted(self._frontiers)]
         surface = cKDTree(np.asarray(cloud, float).reshape(-1, 3))
-        for f, seen in zip(old, self._seen(old, mesh, scene)):
-            seen = seen | on_surface(f.points, surface, a, p)
+        on = _split(on_surface(np.concatenate([f.points for f in old]), surface, a, p), old) if old else []
+        for f, seen, lying in zip(old, self._seen(old, mesh, scene), on):
+            seen = seen | lying
             if not seen.any():
                 continue
             changed_old.append(f)
@@ -226,7 +232,7 @@ class SequentialFrontiers:
                 if np.min(np.linalg.norm(f.points - mesh.viewpoint, axis=1)) <= self.params.d_max_m]
         if near:
             vis = seen_from(np.concatenate([frontiers[k].points for k in near]), mesh, scene, self.params)
-            for k, part in zip(near, np.split(vis, np.cumsum([len(frontiers[k].points) for k in near])[:-1])):
+            for k, part in zip(near, _split(vis, [frontiers[k] for k in near])):
                 seen[k] = part
         return seen
 

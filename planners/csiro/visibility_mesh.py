@@ -20,6 +20,8 @@ spherical-flipping kernel, not the paper's exponential one.
 """
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
 from scipy.spatial import ConvexHull, QhullError, cKDTree
 
@@ -36,7 +38,13 @@ SURFACE_VOXELS = np.sqrt(3.0)
 def _sphere_rows(agent: np.ndarray, params: CsiroFrontierParams, lo_deg: float, hi_deg: float) -> np.ndarray:
     """Points on the sphere of radius d_max around ``agent`` between elevations ``lo_deg`` and
     ``hi_deg`` (both rows included), about eta_disc / 2 apart; rows by elevation then azimuth."""
-    step = params.sphere_spacing_rad
+    return np.asarray(agent, float) + params.d_max_m * _unit_rows(params.sphere_spacing_rad, lo_deg, hi_deg)
+
+
+@lru_cache(maxsize=8)
+def _unit_rows(step: float, lo_deg: float, hi_deg: float) -> np.ndarray:
+    """The unit directions of :func:`_sphere_rows`, made once per spacing and band (every
+    frontier update asks for the same ones)."""
     lo, hi = np.radians(lo_deg), np.radians(hi_deg)
     rows = max(int(np.ceil((hi - lo) / step)), 1)
     out = []
@@ -44,7 +52,9 @@ def _sphere_rows(agent: np.ndarray, params: CsiroFrontierParams, lo_deg: float, 
         n = max(int(np.ceil(2 * np.pi * np.cos(el) / step)), 1)
         az = np.arange(n) * (2 * np.pi / n)
         out.append(np.stack([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.full(n, np.sin(el))], axis=1))
-    return np.asarray(agent, float) + params.d_max_m * np.concatenate(out)
+    units = np.concatenate(out)
+    units.setflags(write=False)
+    return units
 
 
 def sphere_points(agent: np.ndarray, params: CsiroFrontierParams) -> np.ndarray:
@@ -76,17 +86,30 @@ def exponential_inversion(points: np.ndarray, agent: np.ndarray, gamma: float) -
     return d * (r ** (gamma - 1.0))[:, None]
 
 
-def behind_observed(sphere: np.ndarray, cloud: np.ndarray, agent: np.ndarray, width_m: float) -> np.ndarray:
+class CloudDirections:
+    """The observed points as seen from the agent: their ranges and a kd-tree of their unit
+    directions, made once for every :func:`behind_observed` test of one view."""
+
+    def __init__(self, cloud: np.ndarray, agent: np.ndarray) -> None:
+        d = cloud - agent
+        self.agent = agent
+        self.range_m = np.linalg.norm(d, axis=1)
+        self.tree = cKDTree(d / self.range_m[:, None])
+
+
+def behind_observed(sphere: np.ndarray, cloud: np.ndarray | CloudDirections, agent: np.ndarray,
+                    width_m: float) -> np.ndarray:
     """(M,) bool: sphere points straight behind an observed point, within the angle that half of
     ``width_m`` subtends at the range of the cloud point nearest in direction. With the width of a
     voxel they are hidden (give or take half a voxel at the rim of an opening), so leaving them out
     of the hull changes little but its cost: in a drift most of the sphere is behind the walls, and
     qhull takes about a third less time without it. With eta_disc, gaps narrower than a
-    discontinuity in the observed surface count as closed."""
-    d = cloud - agent
-    r = np.linalg.norm(d, axis=1)
+    discontinuity in the observed surface count as closed. ``cloud``: the observed points, or their
+    :class:`CloudDirections` from ``agent``."""
+    seen = cloud if isinstance(cloud, CloudDirections) else CloudDirections(cloud, agent)
+    r = seen.range_m
     u = (sphere - agent) / np.linalg.norm(sphere - agent, axis=1)[:, None]
-    gap, near = cKDTree(d / r[:, None]).query(u, distance_upper_bound=0.5 * width_m / r.min())
+    gap, near = seen.tree.query(u, distance_upper_bound=0.5 * width_m / r.min())
     hit = np.isfinite(gap)
     out = np.zeros(len(sphere), dtype=bool)
     out[hit] = gap[hit] <= 0.5 * width_m / r[near[hit]]
@@ -170,10 +193,11 @@ def visible_mesh(cloud: np.ndarray, agent: np.ndarray,
         return None, f"degenerate point cloud: the {len(cloud)} points in range lie on one plane"
     # the sensor looked along the sphere points of its view; in its blind cones only a gap in the
     # cached surface wider than a discontinuity (eta_disc) is an opening
+    directions = CloudDirections(cloud, a)
     sphere = sphere_points(a, params)
-    sphere = sphere[~behind_observed(sphere, cloud, a, params.d_vox_m)]
+    sphere = sphere[~behind_observed(sphere, directions, a, params.d_vox_m)]
     blind = blind_sphere_points(a, params)
-    blind = blind[~behind_observed(blind, cloud, a, params.eta_disc_m)]
+    blind = blind[~behind_observed(blind, directions, a, params.eta_disc_m)]
     points = np.concatenate([cloud, sphere, blind])
     transformed = np.concatenate([exponential_inversion(points, a, params.gamma), np.zeros((1, 3))])
     try:

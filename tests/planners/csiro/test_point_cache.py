@@ -66,6 +66,25 @@ def test_cloud_is_deterministic():
     assert np.array_equal(clouds[0], clouds[1])
 
 
+def test_kept_decompositions_give_the_cloud_of_a_cache_without_them():
+    """cloud() decomposes only the voxels that points came into since its last call: after
+    scans that add to old voxels and add new ones between them, and a prune, the cloud is
+    the one of a cache that took the same scans with no call between."""
+    rng = np.random.default_rng(3)
+    scans = [rectangle((2.0, -3.0, -1.0), (0, 6, 0), (0, 0, 2)) + rng.normal(0, 0.05, (1, 3)) for _ in range(4)]
+    scans.insert(2, rectangle((-2.0, -4.0, -1.0), (0, 8, 0), (0, 0, 2)))
+    centre = np.array([0.0, 2.5, 0.0])
+    kept, fresh = PointCache(P.d_vox_m), PointCache(P.d_vox_m)
+    for k, scan in enumerate(scans):
+        for cache in (kept, fresh):
+            cache.insert(scan, np.zeros(3))
+            if k == 2:
+                cache.prune(centre, 4.0)
+        kept.cloud(np.zeros(3), P)
+    for agent in (np.zeros(3), np.array([0.5, 1.0, 0.0])):
+        assert np.array_equal(kept.cloud(agent, P), fresh.cloud(agent, P))
+
+
 def test_bad_voxel_size_raises():
     with pytest.raises(ValueError, match="d_vox_m"):
         PointCache(0.0)
