@@ -40,6 +40,9 @@ class PointCache:
     the sums small, so the covariance does not lose precision far from the origin.
     """
 
+    #: The per-voxel arrays, in the order of the voxel keys.
+    _COLUMNS = ("_keys", "_n", "_s1", "_s2", "_ray", "_lam", "_xi", "_stale")
+
     def __init__(self, d_vox_m: float) -> None:
         if not d_vox_m > 0:
             raise ValueError(f"d_vox_m must be > 0, got {d_vox_m}")
@@ -55,9 +58,6 @@ class PointCache:
         self._lam = np.zeros((0, 3))
         self._xi = np.zeros((0, 3, 3))
         self._stale = np.zeros(0, dtype=bool)
-
-    def _columns(self) -> tuple[str, ...]:
-        return ("_keys", "_n", "_s1", "_s2", "_ray", "_lam", "_xi", "_stale")
 
     def __len__(self) -> int:
         return len(self._keys)
@@ -95,14 +95,14 @@ class PointCache:
             added = {"_keys": keys[new], "_n": n[new], "_s1": s1[new], "_s2": s2[new], "_ray": ray[new],
                      "_lam": np.zeros((k, 3)), "_xi": np.zeros((k, 3, 3)), "_stale": np.ones(k, dtype=bool)}
             order = np.argsort(np.concatenate([self._keys, keys[new]]), kind="stable")
-            for name in self._columns():
+            for name in self._COLUMNS:
                 setattr(self, name, np.concatenate([getattr(self, name), added[name]])[order])
 
     def prune(self, agent: np.ndarray, radius_m: float) -> None:
         """Forget the voxels whose mean lies farther than ``radius_m`` from ``agent`` (the cache is
         limited in range)."""
         keep = np.linalg.norm(self.means() - np.asarray(agent, float), axis=1) <= radius_m
-        for name in self._columns():
+        for name in self._COLUMNS:
             setattr(self, name, getattr(self, name)[keep])
 
     def counts(self) -> np.ndarray:
@@ -147,7 +147,6 @@ class PointCache:
         axes = xi[near][:, :, 1:] * half[:, None, :]          # (n, 3, 2) scaled in-plane axes
         sub = mu[near][:, None, :] + np.einsum("kc,ndc->nkd", _KL, axes)
         return np.concatenate([mu[far], sub.reshape(-1, 3)])
-
 
     def _eigen(self, idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """``np.linalg.eigh`` of the covariances of the voxels ``idx``, from the kept ones where

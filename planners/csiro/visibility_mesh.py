@@ -92,7 +92,6 @@ class CloudDirections:
 
     def __init__(self, cloud: np.ndarray, agent: np.ndarray) -> None:
         d = cloud - agent
-        self.agent = agent
         self.range_m = np.linalg.norm(d, axis=1)
         self.tree = cKDTree(d / self.range_m[:, None])
 
