@@ -1,13 +1,14 @@
-"""The legged navigation graph kept up to date from the voxels that changed.
+"""Navigation graphs kept up to date from the voxels that changed.
 
-:func:`delve.planners.navgraph.legged_graph` rebuilds the graph over every free voxel
-of the map. Whether a voxel is a node, though, depends only on the map a few voxels
-around it, and a node's edges on the nodes next to it. :class:`LeggedGraphUpdater`
-keeps, per voxel, what each rule of ``legged_graph`` concluded (rock, ground, standable,
-node) and the edges by voxel; an update follows a change through the rules, recomputing
-a rule only where one of its inputs changed (a LiDAR sweep frees thousands of voxels of
-air, which change no node), then numbers the nodes as the full build does (in the
-map's order of free voxels), so the graph equals ``legged_graph``'s exactly.
+:func:`delve.planners.navgraph.legged_graph` and :func:`~delve.planners.navgraph.aerial_graph`
+rebuild a graph over every free voxel of the map. Whether a voxel is a node, though,
+depends only on the map a few voxels around it, and a node's edges on the nodes next to
+it. :class:`LeggedGraphUpdater` and :class:`AerialGraphUpdater` keep, per voxel, what
+each rule of the full build concluded (rock, ground, standable, node) and the edges by
+voxel; an update follows a change through the rules, recomputing a rule only where one
+of its inputs changed (a LiDAR sweep frees thousands of voxels of air, which change no
+node), then numbers the nodes as the full build does (in the map's order of free
+voxels), so the graph equals the full build's exactly.
 """
 from __future__ import annotations
 
@@ -16,7 +17,8 @@ import math
 import numpy as np
 from scipy.sparse import csr_matrix
 
-from .navgraph import _NEIGHBOURS_8, NavGraph, Voxels, _Lookup, around, distinct, inclination_among, inclination_reach
+from .navgraph import (_NEIGHBOURS_8, NavGraph, Voxels, _ball, _Lookup, around, distinct, inclination_among,
+                       inclination_reach)
 from .occupancy import FREE, OCCUPIED, UNKNOWN, Grid
 
 
@@ -119,16 +121,16 @@ class LeggedGraphUpdater:
             changed = np.flatnonzero(occ != UNKNOWN)
         changed = np.asarray(changed, dtype=np.int64)
         sh = self._shape
-        rock = self._set(self.rock, changed, occ[changed] == OCCUPIED)
+        rock = _store(self.rock, changed, occ[changed] == OCCUPIED)
         ground = around(changed, sh, [(0, 0, 0), (0, 0, 1)])
         q = Voxels(ground, sh)
-        ground = self._set(self.ground, ground, (occ[ground] == FREE) & (q.at(occ, (0, 0, -1), UNKNOWN) == OCCUPIED))
+        ground = _store(self.ground, ground, (occ[ground] == FREE) & (q.at(occ, (0, 0, -1), UNKNOWN) == OCCUPIED))
         stand = distinct(sh, np.concatenate([around(changed, sh, [(0, 0, 0), (0, 0, 1)]), around(ground, sh, self._disc),
                                              around(rock, sh, [(0, 0, -c) for c in range(1, self.n_up + 1)])]))
-        stand = self._set(self.standable, stand, self._where_free(occ, stand, self._standable))
+        stand = _store(self.standable, stand, self._where_free(occ, stand, self._standable))
         node = distinct(sh, np.concatenate([around(stand, sh, [(0, 0, 0)] + _negated(self._slope)),
                                             around(rock, sh, _negated(self._body))]))
-        node = self._set(self.node, node, self._where_free(occ, node, self._nodes, among=self.standable))
+        node = _store(self.node, node, self._where_free(occ, node, self._nodes, among=self.standable))
         sources = around(node, sh, [(0, 0, 0)] + _negated(self._offsets + self._sides))
         src, dst, w = self._edges
         with _Lookup(len(self.node), sources) as redo:
@@ -148,14 +150,6 @@ class LeggedGraphUpdater:
         out[out] = rule(occ, Voxels(flat[out], self._shape))
         return out
 
-    @staticmethod
-    def _set(state: np.ndarray, flat: np.ndarray, value: np.ndarray) -> np.ndarray:
-        """Store a rule's conclusions for the voxels ``flat``; the voxels where they changed."""
-        value = value.astype(np.uint8)
-        changed = flat[state[flat] != value]
-        state[flat] = value
-        return changed
-
     def _graph(self, grid: Grid, src: np.ndarray, dst: np.ndarray, w: np.ndarray) -> NavGraph:
         """The nodes in the map's order of free voxels, numbered, and their edges."""
         free = grid.free_voxels()   # only the nodes' positions are needed, not Voxels of all free ones
@@ -166,6 +160,104 @@ class LeggedGraphUpdater:
         with _Lookup(len(self.node), nodes) as ids:
             rows, cols = ids[src].astype(np.int64) - 1, ids[dst].astype(np.int64) - 1
         return NavGraph(positions=positions, adjacency=csr_matrix((w, (rows, cols)), shape=(n, n)))
+
+
+class AerialGraphUpdater:
+    """The aerial navigation graph of one map (:func:`delve.planners.navgraph.aerial_graph`
+    with its parameters), updated from its changed voxels. A node is a free voxel of the
+    lattice with no rock within the robot's radius: only voxels that turned free or not
+    free, and the lattice voxels within the radius of voxels that turned rock or not rock,
+    are tested again. Memory: two bytes per voxel of the grid (zero-filled) and the edges."""
+
+    def __init__(self, *, radius_m: float, stride: int = 2):
+        self.radius_m, self.stride = radius_m, stride
+        self._shape: tuple[int, int, int] | None = None
+
+    def _setup(self, grid: Grid) -> None:
+        """The rules' offsets for this grid's voxel size, and the state of an unknown map."""
+        size, s = int(np.prod(grid.shape)), self.stride
+        self._shape, self._vox = grid.shape, grid.voxel_size_m
+        self.rock, self.node = np.zeros(size, np.uint8), np.zeros(size, np.uint8)
+        self._edges = (np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0))
+        self._ball = _ball(max(1, math.ceil(self.radius_m / grid.voxel_size_m)))
+        self._offsets = [(a * s, b * s, c * s) for a in (-1, 0, 1) for b in (-1, 0, 1) for c in (-1, 0, 1)
+                         if (a, b, c) > (0, 0, 0)]
+
+    def update(self, grid: Grid, changed: np.ndarray | None = None) -> NavGraph:
+        """The graph of ``grid`` after the voxels ``changed`` (flat indices) changed since
+        the last update; from every known voxel when ``changed`` is None or on the first
+        update (or for a grid of another shape)."""
+        occ = grid.occupancy.reshape(-1)
+        if changed is None or self._shape != grid.shape:
+            self._setup(grid)
+            changed = np.flatnonzero(occ != UNKNOWN)
+        changed = np.asarray(changed, dtype=np.int64)
+        sh = self._shape
+        rock = _store(self.rock, changed, occ[changed] == OCCUPIED)
+        test = distinct(sh, np.concatenate([self._on_lattice(changed), self._lattice_around(rock)]))
+        node = _store(self.node, test, self._is_node(occ, test))
+        sources = around(node, sh, [(0, 0, 0)] + _negated(self._offsets))
+        src, dst, w = self._edges
+        with _Lookup(len(self.node), sources) as redo:
+            keep = redo[src] == 0
+        new = self._edges_from(Voxels(sources[self.node[sources] > 0], sh))
+        self._edges = src, dst, w = (np.concatenate([src[keep], new[0]]), np.concatenate([dst[keep], new[1]]),
+                                     np.concatenate([w[keep], new[2]]))
+        free = grid.free_voxels()
+        nodes = free[self.node[free] > 0]
+        n = len(nodes)
+        with _Lookup(len(self.node), nodes) as ids:
+            rows, cols = ids[src].astype(np.int64) - 1, ids[dst].astype(np.int64) - 1
+        positions = grid.to_world(np.stack(np.unravel_index(nodes, sh), axis=1))
+        return NavGraph(positions=positions, adjacency=csr_matrix((w, (rows, cols)), shape=(n, n)))
+
+    def _on_lattice(self, flat: np.ndarray) -> np.ndarray:
+        ijk = np.unravel_index(flat, self._shape)
+        return flat[(ijk[0] % self.stride == 0) & (ijk[1] % self.stride == 0) & (ijk[2] % self.stride == 0)]
+
+    def _lattice_around(self, flat: np.ndarray) -> np.ndarray:
+        """The lattice voxels within the radius of the voxels ``flat``: per class of a voxel's
+        position on the lattice, only the offsets of the ball that land on it (an eighth of
+        them for a stride of 2)."""
+        s = self.stride
+        ijk = np.stack(np.unravel_index(flat, self._shape), axis=1) % s
+        parts = []
+        for cls in {tuple(c) for c in np.unique(ijk, axis=0)}:
+            offsets = [d for d in self._ball if all((c + o) % s == 0 for c, o in zip(cls, d))]
+            if offsets:
+                parts.append(around(flat[np.all(ijk == cls, axis=1)], self._shape, offsets))
+        return np.concatenate(parts) if parts else np.zeros(0, np.int64)
+
+    def _is_node(self, occ: np.ndarray, flat: np.ndarray) -> np.ndarray:
+        """Which lattice voxels ``flat`` are nodes: free, with no rock (nor the grid's edge)
+        within the radius."""
+        out = occ[flat] == FREE
+        q = Voxels(flat[out], self._shape)
+        keep = np.ones(len(q), dtype=bool)
+        for d in self._ball:
+            keep &= q.at(occ, d, OCCUPIED) != OCCUPIED
+        out[out] = keep
+        return out
+
+    def _edges_from(self, q: Voxels) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Edges (source flat, target flat, length) from the ``q`` voxels (nodes) to the
+        nodes at the lattice offsets, as :func:`delve.planners.navgraph._graph` makes them."""
+        src, dst, w = [], [], []
+        ny, nz = self._shape[1], self._shape[2]
+        for d in self._offsets:
+            s = q.flat[q.at(self.node, d, 0) > 0]
+            src.append(s)
+            dst.append(s + (d[0] * ny + d[1]) * nz + d[2])
+            w.append(np.full(len(s), self._vox * math.sqrt(d[0] ** 2 + d[1] ** 2 + d[2] ** 2)))
+        return np.concatenate(src), np.concatenate(dst), np.concatenate(w)
+
+
+def _store(state: np.ndarray, flat: np.ndarray, value: np.ndarray) -> np.ndarray:
+    """Store a rule's conclusions for the voxels ``flat``; the voxels where they changed."""
+    value = value.astype(np.uint8)
+    changed = flat[state[flat] != value]
+    state[flat] = value
+    return changed
 
 
 def _negated(offsets: list[tuple[int, int, int]]) -> list[tuple[int, int, int]]:

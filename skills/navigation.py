@@ -3,7 +3,7 @@
 The :class:`Navigator` keeps the navigation graph of the robot's onboard map and the
 shortest-path tree from the robot, and rebuilds them when the map has changed and
 they are older than ``rebuild_period_s`` (10 s) of sim time, so that several skills ticking
-in one agent do not plan twice. A legged robot's graph is updated from the voxels that
+in one agent do not plan twice. The graph (legged or aerial) is updated from the voxels that
 changed since the last build (the map's change log), not rebuilt over the whole map, and
 so is the map's set of frontier voxels (:meth:`Navigator.frontier_voxels`).
 """
@@ -16,8 +16,8 @@ from typing import Any
 import numpy as np
 
 from ..planners.frontier_incremental import FrontierUpdater
-from ..planners.navgraph import NavGraph, aerial_graph
-from ..planners.navgraph_incremental import LeggedGraphUpdater
+from ..planners.navgraph import NavGraph
+from ..planners.navgraph_incremental import AerialGraphUpdater, LeggedGraphUpdater
 from ..planners.occupancy import Grid
 from .base import AgentContext
 from .robot import ChangeLog, Robot
@@ -67,8 +67,7 @@ class Navigator:
         if force or stale or self._graph is None:
             mob = self.robot.mobility
             if mob.aerial:
-                self._graph = aerial_graph(self.grid(), radius_m=mob.radius_m)
-
+                self._graph = self.updated("aerial graph", lambda: AerialGraphUpdater(radius_m=mob.radius_m))
             else:
                 self._graph = self._legged_graph()
             self._graph_key = (version, now)
