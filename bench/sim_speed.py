@@ -36,6 +36,7 @@ from delve.executive.runner import Mission
 from delve.executive.scenario import load_scenario
 from delve.planners import frontier, navgraph
 from delve.planners.frontier_incremental import FrontierUpdater
+from delve.planners import navgraph_incremental
 from delve.planners.navgraph_incremental import LeggedGraphUpdater
 from delve.sim import robot as robot_mod
 from delve.sim.voxel_map import VoxelMap
@@ -82,6 +83,7 @@ def instrument() -> None:
         timed(mod, "aerial_graph", "planning")
     timed(navgraph, "legged_graph", "planning")
     timed(LeggedGraphUpdater, "update", "planning")
+    timed(getattr(navgraph_incremental, "AerialGraphUpdater", None), "update", "planning")
     timed(FrontierUpdater, "update", "planning")
     timed(navgraph.NavGraph, "shortest_paths", "planning")
     for mod in (exploration, frontier):
