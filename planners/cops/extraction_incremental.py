@@ -178,7 +178,7 @@ class ExtractionUpdater:
         mask = np.zeros(grid.shape, dtype=bool)
         mask.reshape(-1)[stand] = True
         return extract_topology(grid.occupancy, grid.origin, grid.voxel_size_m, standable=mask,
-                                passable=grid.occupancy == FREE, free=grid.free, cell_m=self.cell_m,
+                                passable=grid.occupancy == FREE, free=grid.free_voxels(), cell_m=self.cell_m,
                                 comm_range_m=self.comm_range_m, min_free_voxels=self.min_free_voxels,
                                 sight_height_m=self.sight_height_m, visited=visited,
                                 lattice_origin=self.corner, open_radius_m=self.open_radius_m,

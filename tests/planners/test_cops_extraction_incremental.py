@@ -29,7 +29,7 @@ def full(grid: Grid, standable: np.ndarray, **kw) -> Topology:
     mask = np.zeros(grid.shape, dtype=bool)
     mask.reshape(-1)[standable] = True
     return extract_topology(grid.occupancy, grid.origin, grid.voxel_size_m, standable=mask,
-                            passable=grid.occupancy == FREE, free=grid.free, **kw)
+                            passable=grid.occupancy == FREE, free=grid.free_voxels(), **kw)
 
 
 def recorded_params() -> dict:
@@ -154,7 +154,8 @@ def test_a_change_of_the_standable_voxels_alone_is_followed():
 
 def test_where_a_layer_falls_in_another_cell_counted_from_the_crop_the_update_is_the_full_one(monkeypatch):
     occ = room()
-    grid = Grid(occ, np.zeros(3), V)
+    # the free voxels given by a function, as a robot's navigator gives them
+    grid = Grid(occ, np.zeros(3), V, lambda: np.flatnonzero(occ.reshape(-1) == FREE))
     params = dict(cell_m=CELL_M, lattice_origin=ROOM_CORNER)
     updater = ExtractionUpdater(**params)
     updater.update(grid, standable=floor_of(occ))
