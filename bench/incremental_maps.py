@@ -1,9 +1,10 @@
-"""Incremental maps (issue 17 item 1): time per update of the legged navigation graph,
-of the frontier set and (COPS on voxel worlds) of the COPS network extraction, updated
-from the changed voxels against recomputed over the whole map, at every update of a
-real mission, with a check that the two agree.
+"""Incremental maps (issue 17 item 1): time per update of the legged and of the aerial
+navigation graph, of the frontier set and (COPS on voxel worlds) of the COPS network
+extraction, updated from the changed voxels against recomputed over the whole map, at
+every update of a real mission, with a check that the two agree.
 
-    .venv/bin/python bench/incremental_maps.py [--scenario scenarios/demo.yaml]
+    .venv/bin/python bench/incremental_maps.py [--scenario scenarios/demo.yaml] [--duration-s S]
+    .venv/bin/python bench/incremental_maps.py --scenario scenarios/csiro_explore_sync.yaml --duration-s 600
 
 The mission runs as usual (its navigators update their legged graphs from the maps'
 change logs, COPS views their topologies); at each update this benchmark also builds
@@ -30,7 +31,8 @@ from delve.planners.cops.extraction import extract_topology
 from delve.planners.cops.extraction_incremental import ExtractionUpdater
 from delve.planners.frontier import frontier_voxels
 from delve.planners.frontier_incremental import FrontierUpdater
-from delve.planners.navgraph import legged_graph
+from delve.planners.navgraph import aerial_graph, legged_graph
+from delve.planners.navgraph_incremental import AerialGraphUpdater
 from delve.planners.occupancy import FREE
 from delve.skills import navigation
 
@@ -67,7 +69,7 @@ def instrument() -> None:
         want = timed("frontier set, whole map", frontier_voxels, grid)
         if not np.array_equal(got, want):
             MISMATCHES.append(f"frontier set at {self.ctx.clock.now_s:.1f} s")
-        TIMES["free voxels"].append(len(grid.free))
+        TIMES["free voxels"].append(len(grid.free_voxels()))
         return graph
 
     navigation.Navigator._legged_graph = wrapper
@@ -89,13 +91,28 @@ def instrument_cops() -> None:
     ExtractionUpdater.update = wrapper
 
 
+def instrument_aerial() -> None:
+    """Wrap AerialGraphUpdater.update: time it, and compare with aerial_graph."""
+    incremental = AerialGraphUpdater.update
+
+    def wrapper(self, grid, changed=None):
+        graph = timed("aerial graph, incremental", incremental, self, grid, changed)
+        full = timed("aerial graph, whole map", aerial_graph, grid, radius_m=self.radius_m, stride=self.stride)
+        if not (np.array_equal(graph.positions, full.positions) and (graph.adjacency != full.adjacency).nnz == 0):
+            MISMATCHES.append(f"aerial graph {len(TIMES['aerial graph, incremental'])}")
+        TIMES["free voxels"].append(len(grid.free_voxels()))
+        return graph
+
+    AerialGraphUpdater.update = wrapper
+
+
 def whole_map_extraction(updater: ExtractionUpdater, grid, standable, **kwargs):
     """``extract_topology`` with the updater's parameters, as the COPS view called it
     before (dense masks of the standable and of the passable voxels)."""
     mask = np.zeros(grid.shape, dtype=bool)
     mask.reshape(-1)[standable] = True
     return extract_topology(grid.occupancy, grid.origin, grid.voxel_size_m, standable=mask,
-                            passable=grid.occupancy == FREE, free=grid.free, cell_m=updater.cell_m,
+                            passable=grid.occupancy == FREE, free=grid.free_voxels(), cell_m=updater.cell_m,
                             comm_range_m=updater.comm_range_m, min_free_voxels=updater.min_free_voxels,
                             sight_height_m=updater.sight_height_m, lattice_origin=updater.corner,
                             open_radius_m=updater.open_radius_m, max_region_m=updater.max_region_m, **kwargs)
@@ -104,11 +121,13 @@ def whole_map_extraction(updater: ExtractionUpdater, grid, standable, **kwargs):
 def main() -> int:
     ap = argparse.ArgumentParser()
     ap.add_argument("--scenario", type=Path, default=Path(__file__).parent.parent / "scenarios" / "demo.yaml")
+    ap.add_argument("--duration-s", type=float, help="override the scenario's duration (sim seconds)")
     args = ap.parse_args()
     scenario = load_scenario(args.scenario)
     instrument()
     instrument_cops()
-    mission = Mission(scenario, world=scenario.build_world())
+    instrument_aerial()
+    mission = Mission(scenario, world=scenario.build_world(), duration_s=args.duration_s)
     mission.run()
     print(f"$ {' '.join(sys.argv)}")
     n, cops = len(TIMES["free voxels"]), len(TIMES["COPS extraction, incremental"])
@@ -116,7 +135,8 @@ def main() -> int:
     print(f"scenario {scenario.name}: {n} navigation-graph updates{extractions}, "
           f"up to {max(TIMES['free voxels']):,} free voxels\n")
     print(f"{'per update':<30}{'median ms':>10}{'total s':>9}{'ratio':>8}")
-    for part in ("legged graph", "frontier set") + (("COPS extraction",) if cops else ()):
+    parts = [p for p in ("legged graph", "frontier set", "aerial graph", "COPS extraction") if TIMES[f"{p}, incremental"]]
+    for part in parts:
         whole = statistics.median(TIMES[f"{part}, whole map"])
         for key in (f"{part}, whole map", f"{part}, incremental"):
             median = statistics.median(TIMES[key])
