@@ -299,6 +299,18 @@ def test_return_ends_where_a_ping_on_the_way_is_answered(tunnel):
     assert not events(ctx, "cohort_link_point") and robot.path_status != PathStatus.FOLLOWING
 
 
+def test_return_follows_gbplanner2s_global_graph_and_the_navigation_graph_where_it_has_none(tunnel):
+    _, a, _ = tunnel
+    robot, ctx, node = returning(tunnel, 9.0, [5.0], ping_every_s=1000.0)   # a direct edge of the global graph
+    robot.radio.link_up = True
+    assert run(node, ctx, robot) == Status.SUCCESS
+    assert [e["source"] for e in events(ctx, "goto")] == ["gbplanner2"]
+    robot, ctx, node = returning(tunnel, 30.0, [5.0], ping_every_s=1000.0)   # beyond the global graph's reach
+    robot.radio.link_up = True
+    assert run(node, ctx, robot) == Status.SUCCESS
+    assert [e["source"] for e in events(ctx, "goto")] == ["navigator"]
+
+
 def test_return_ends_at_home_and_fails_when_no_point_links(tunnel):
     robot, ctx, node = returning(tunnel, 20.0, [10.0])
     assert run(node, ctx, robot) == Status.FAILURE
