@@ -23,7 +23,7 @@ from pathlib import Path
 
 from .. import SCENARIOS_DIR, TREES_DIR
 from .errors import DelveError
-from .outpaths import check_out_dir, check_out_file
+from .outpaths import check_out_dir, check_out_file, default_out
 from .yamlio import YamlDict, load_yaml
 
 DEMO_SCENARIO = SCENARIOS_DIR / "demo.yaml"
@@ -66,8 +66,8 @@ def _parser() -> argparse.ArgumentParser:
     swp.add_argument("--quiet", action="store_true", help="no progress bar")
     for command in (run, val, ren, wld, swp):
         command.add_argument("--include-path", type=Path, action="append", default=[], metavar="DIR",
-                             help="a folder that tree includes may also resolve into (besides the tree's own "
-                                  "folder and the shipped trees); repeatable")
+                             help="a folder that tree includes (and a sweep's scenarios) may also resolve into "
+                                  "(besides their own folder and the shipped ones); repeatable")
     demo = sub.add_parser("demo", help="run the default scenario into ./delve-out/demo")
     demo.add_argument("--quiet", action="store_true", help="no progress bar")
     return p
@@ -160,7 +160,7 @@ def run(path: Path, out: Path | None, seed: int | None, duration_s: float | None
         raise DelveError(f"--duration-s {steps_problem(duration_s, scenario.dt_s)}")
     if duration_s is not None and duration_s < scenario.duration_s:  # those after the file's end were named
         warn_late_events(scenario.doc, scenario.path, duration_s, scenario.duration_s, "--duration-s")
-    out = out or Path("delve-out") / scenario.name
+    out = out or default_out(scenario.name)
     check_out_dir(out)
     started = time.perf_counter()
     loaded = scenario.build_world()

@@ -8,6 +8,7 @@ before a world is built or a simulation runs, never after a run has finished.
 from __future__ import annotations
 
 import os
+import re
 import tempfile
 from pathlib import Path
 
@@ -90,3 +91,11 @@ def _check_out_file(path: Path, option: str) -> None:
             path.unlink()
     except OSError as err:
         raise DelveError(f"{option} {_shown(path)}: cannot write there ({_reason(err)})") from None
+
+
+def default_out(name: str) -> Path:
+    """``delve-out/<name>``, the output folder when none is given, with the name made one
+    plain folder name: a scenario's or sweep's ``name:`` of ``../../x`` or ``/tmp/x``
+    must not put the outputs elsewhere."""
+    folder = re.sub(r"[^A-Za-z0-9_.-]+", "_", name).lstrip(".") or "run"
+    return Path("delve-out") / folder

@@ -18,7 +18,7 @@ from pathlib import Path
 from typing import Any, Callable, Iterator
 
 from .errors import DelveError, clip_message
-from .outpaths import check_out_dir
+from .outpaths import check_out_dir, default_out
 from .sweep_run import failed_record, finished_record, run_one
 from .sweep_spec import RunSpec, Sweep
 from .sweep_table import plot_figures, results_table, write_table
@@ -140,7 +140,7 @@ def sweep_command(path: Path, out: Path | None, workers: int | None, scheduler: 
     if workers is not None and scheduler:
         raise DelveError("--workers sizes the local cluster: leave it out with --scheduler")
     sweep = load_sweep(path, include_path)
-    out = out or Path("delve-out") / sweep.name
+    out = out or default_out(sweep.name)
     try:
         with (_no_bar() if quiet else progress_bar(sweep.name)) as progress:
             result = run_sweep(sweep, out, workers=workers, scheduler=scheduler, retry_failed=retry_failed,

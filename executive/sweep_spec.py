@@ -24,16 +24,19 @@ import hashlib
 import itertools
 import json
 import math
+import os
 import re
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from .. import SCENARIOS_DIR
 from ..skills.base import short_repr
-from .errors import DelveError, did_you_mean
+from .errors import DelveError, did_you_mean, display_path
 from .scenario import Scenario, load_scenario
-from .yamlio import YamlDict, YamlList, load_yaml, plain
+from .tree_loader import path_inside
+from .yamlio import YamlDict, YamlList, file_problem, load_yaml, plain
 
 KEYS = ("name", "scenarios", "seeds", "grid", "runs")
 RUN_KEYS = ("label", "scenario", "set")
@@ -41,6 +44,8 @@ SEED_KEYS = ("count", "first")
 #: Most runs one sweep may make: at a minute a run, a week of a 64-core machine; more
 #: is a typo (``count: 1000000``) that would fill the disk with run folders.
 MAX_RUNS = 10_000
+#: The largest seed: the results table keeps seeds as 64-bit integers (Parquet).
+MAX_SEED = 2**63 - 1
 #: Longest run id (a folder name); a longer one is cut and ends in a digest of the whole.
 MAX_ID_CHARS = 120
 #: Characters of a run id besides letters and digits; any other becomes ``_``.
@@ -129,6 +134,9 @@ def load_sweep(path: str | Path, include_path: tuple[Path, ...] = ()) -> Sweep:
         raise DelveError(f"name: must be a non-empty string, not {short_repr(name)}", path, doc.key_line("name"))
     seeds, grid = _seeds(doc, path), _grid(doc, path)
     entries = _run_entries(doc, path, _scenario_files(doc, path))
+    for _, files, _ in entries:
+        for file, line in files:
+            _check_allowed(file, path, line, include_path)
     total = sum(len(files) for _, files, _ in entries) * math.prod(map(len, grid)) * max(1, len(seeds))
     if total > MAX_RUNS:
         raise DelveError(f"sweep: {total:,} runs, more than the limit of {MAX_RUNS:,}", path, doc.line)
@@ -211,9 +219,26 @@ def _scenario_file(item: Any, path: Path, line: int | None, where: str) -> tuple
     if not isinstance(item, str) or not item:
         raise DelveError(f"{where}: a scenario file name, not {short_repr(item)}", path, line)
     file = path.parent / item
-    if not file.is_file():
-        raise DelveError(f"{where}: scenario file not found: {short_repr(item)[1:-1]}", path, line)
+    shipped = SCENARIOS_DIR / f"{item}.yaml"
+    if not file.exists() and "/" not in item and not Path(item).suffix and shipped.is_file():
+        file = shipped   # a shipped scenario by its name, as `delve run demo`
+    problem = file_problem(file)
+    if problem:
+        raise DelveError(f"{where}: scenario file {problem}: {short_repr(item)[1:-1]}", path, line)
     return file, line
+
+
+def _check_allowed(file: Path, path: Path, line: int | None, include_path: tuple[Path, ...]) -> None:
+    """A scenario file must lie, symbolic links followed, in the sweep's folder, the shipped
+    scenarios or an ``include_path`` folder (as a tree's file must): a sweep file from
+    elsewhere cannot have delve read, and quote in its errors, any file of the machine."""
+    roots = dict.fromkeys([os.path.realpath(path.parent), os.path.realpath(SCENARIOS_DIR),
+                           *(os.path.realpath(p) for p in include_path)])
+    if not any(path_inside(os.path.realpath(file), root) for root in roots):
+        given = file.relative_to(path.parent) if file.is_relative_to(path.parent) else file
+        raise DelveError(f"scenario {short_repr(str(given))} is outside the allowed folders (the sweep's folder "
+                         f"{os.path.join(display_path(path.parent), '')}, the shipped scenarios; add --include-path)",
+                         path, line)
 
 
 def _seeds(doc: YamlDict, path: Path) -> list[int]:
@@ -226,9 +251,9 @@ def _seeds(doc: YamlDict, path: Path) -> list[int]:
     if isinstance(given, dict):
         _known_keys(given, SEED_KEYS, "seeds", path)
         count, first = given.get("count"), given.get("first", 1)
-        for key, value, low, high in (("count", count, 1, MAX_RUNS), ("first", first, 0, math.inf)):
+        for key, value, low, high in (("count", count, 1, MAX_RUNS), ("first", first, 0, MAX_SEED - MAX_RUNS)):
             if isinstance(value, bool) or not isinstance(value, int) or not low <= value <= high:
-                span = f"from {low} to {high}" if high < math.inf else f">= {low}"
+                span = f"from {low} to {high}"
                 raise DelveError(f"seeds: {key} must be an integer {span}, not {short_repr(value)}", path,
                                  given.key_line(key))
         return [first + i for i in range(count)]
@@ -237,8 +262,8 @@ def _seeds(doc: YamlDict, path: Path) -> list[int]:
     seeds = []
     for i, seed in enumerate(given):
         at = given.item_line(i) if isinstance(given, YamlList) else line
-        if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
-            raise DelveError(f"seeds/{i}: a seed is an integer >= 0, not {short_repr(seed)}", path, at)
+        if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed <= MAX_SEED:
+            raise DelveError(f"seeds/{i}: a seed is an integer from 0 to {MAX_SEED}, not {short_repr(seed)}", path, at)
         if seed in seeds:
             raise DelveError(f"seeds/{i}: seed {seed} is given twice", path, at)
         seeds.append(seed)

@@ -66,3 +66,11 @@ def test_render_out_in_a_new_folder_is_made(tmp_path, monkeypatch, capsys):
 def test_out_dir_probe_leaves_nothing(tmp_path):
     cli.check_out_dir(tmp_path / "a" / "b")
     assert list((tmp_path / "a" / "b").iterdir()) == []
+
+
+@pytest.mark.parametrize("name, folder", [("demo", "demo"), ("../../escaped", "_.._escaped"), ("/tmp/x", "_tmp_x"),
+                                          ("..", "run"), ("my run: 2", "my_run_2")])
+def test_the_default_out_folder_is_one_folder_in_delve_out_whatever_the_name(name, folder):
+    from delve.executive.outpaths import default_out
+
+    assert default_out(name) == Path("delve-out") / folder

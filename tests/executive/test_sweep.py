@@ -7,6 +7,7 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
+from delve import TREES_DIR
 from delve.executive.cli import main
 from delve.executive.errors import DelveError
 from delve.executive.sweep_run import MARKER, finished_record, one_line
@@ -18,8 +19,12 @@ SMALL = Path(__file__).parent.parent / "scenarios" / "data" / "small_tunnel.yaml
 
 
 def sweep_file(tmp_path: Path, text: str) -> Path:
+    """A sweep file in ``tmp_path`` where SMALL names a copy of small_tunnel.yaml beside it
+    (a sweep's scenarios lie in its folder or the shipped scenarios)."""
+    small = tmp_path / SMALL.name
+    small.write_text(SMALL.read_text().replace("../../../trees", str(TREES_DIR)))
     path = tmp_path / "s.yaml"
-    path.write_text(text.replace("SMALL", str(SMALL)))
+    path.write_text(text.replace("SMALL", str(small)).replace("../../../trees", str(TREES_DIR)))
     return path
 
 
@@ -71,6 +76,11 @@ grid:
     assert run.run_id.startswith("small_tunnel-robots.0.tree=gbplanner_explorer.yaml-robots.0.start=h")
 
 
+def test_a_shipped_scenario_by_its_name(tmp_path):
+    sweep = load_sweep(sweep_file(tmp_path, "scenarios: [demo]\nruns:\n  - {}\n  - {scenario: cops_mine, set: {}}\n"))
+    assert [run.scenario_file.name for run in sweep.runs] == ["demo.yaml", "cops_mine.yaml"]
+
+
 def test_overrides_make_missing_mappings_and_index_lists():
     doc = loads_yaml("name: x\nrobots:\n  - {name: a}\n")
     out = apply_overrides(doc, (Override("radio.range_m", 40, 3), Override("robots.0.name", "b", 4)))
@@ -84,7 +94,11 @@ def test_overrides_make_missing_mappings_and_index_lists():
 @pytest.mark.parametrize("text, line, expect", [
     ("scenarios: [SMALL]\ngird: {}\n", 2, "sweep: unknown key 'gird' (did you mean 'grid'?)"),
     ("scenarios: [nope.yaml]\n", 1, "scenarios: scenario file not found: nope.yaml"),
-    ("scenarios: [SMALL]\nseeds: [1, -2]\n", 2, "seeds/1: a seed is an integer >= 0, not -2"),
+    ("scenarios: [/etc]\n", 1, "scenarios: scenario file is a directory: /etc"),
+    ("scenarios: [../elsewhere.yaml]\n", 1, "scenario '../elsewhere.yaml' is outside the allowed folders"),
+    ("runs:\n  - {scenario: ../elsewhere.yaml, set: {}}\n", 2, "scenario '../elsewhere.yaml' is outside the "),
+    ("scenarios: [SMALL]\nseeds: [1, -2]\n", 2, "seeds/1: a seed is an integer from 0 to 9223372036854775807, not -2"),
+    ("scenarios: [SMALL]\nseeds: [99999999999999999999]\n", 2, "seeds/0: a seed is an integer from 0 to "),
     ("scenarios: [SMALL]\nseeds: {count: 0}\n", 2, "seeds: count must be an integer from 1 to 10000, not 0"),
     ("scenarios: [SMALL]\nseeds: {count: 9000}\ngrid: {duration_s: [1, 2]}\n", 1,
      "sweep: 18,000 runs, more than the limit of 10,000"),
@@ -99,6 +113,7 @@ def test_overrides_make_missing_mappings_and_index_lists():
     ("- a\n", 1, "a sweep file must be a mapping"),
 ])
 def test_a_mistake_is_one_line_at_its_key(tmp_path, capsys, text, line, expect):
+    (tmp_path.parent / "elsewhere.yaml").write_text("secret: 1\n")   # readable, but not the sweep's to read
     path = sweep_file(tmp_path, text)
     err = cli_error(path, capsys)
     assert err.startswith(f"{path}:{line}: ") or err.startswith(f"{path.name}:{line}: "), err
