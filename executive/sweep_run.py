@@ -77,8 +77,9 @@ def _mission(spec: RunSpec, folder: Path, started: float) -> dict[str, Any]:
 def one_line(err: BaseException) -> str:
     """An error as one line: a DelveError as it prints; anything else as its type,
     message and the place it was raised."""
-    if isinstance(err, DelveError):
-        return clip_message(err, 300)
+    if isinstance(err, DelveError):   # its own words, with the file and line it names whole
+        line = " ".join(str(err).split())
+        return line if len(line) <= 300 else line[:300] + "..."
     where = traceback.extract_tb(err.__traceback__)[-1] if err.__traceback__ else None
     at = f" (at {Path(where.filename).name}:{where.lineno})" if where else ""
     return clip_message(f"{type(err).__name__}: {err}{at}", 300)

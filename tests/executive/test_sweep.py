@@ -157,6 +157,8 @@ def test_an_error_is_one_line_with_where_it_was_raised():
         text = one_line(err)
     assert text.startswith("KeyError: 'missing' (at test_sweep.py:") and "\n" not in text
     assert one_line(DelveError("bad\nvalue", "x.yaml", 3)) == "x.yaml:3: bad value"
+    long = "/home/someone/experiments/2026/scenarios/gbplanner_demo.yaml"    # a run's error names it whole
+    assert one_line(DelveError("world: cannot lay out", long, 12)).startswith(f"{long}:12: world")
 
 
 REPORT = {"scenario": "small_tunnel", "seed": 1, "succeeded": True, "wall_time_s": 2.0,
