@@ -44,6 +44,8 @@ SEED_KEYS = ("count", "first")
 #: Most runs one sweep may make: at a minute a run, a week of a 64-core machine; more
 #: is a typo (``count: 1000000``) that would fill the disk with run folders.
 MAX_RUNS = 10_000
+#: The world's keys that name a file (relative to the scenario).
+WORLD_FILE_KEYS = ("mesh", "network", "trajectory")
 #: The largest seed: the results table keeps seeds as 64-bit integers (Parquet).
 MAX_SEED = 2**63 - 1
 #: Longest run id (a folder name); a longer one is cut and ends in a digest of the whole.
@@ -133,10 +135,7 @@ def load_sweep(path: str | Path, include_path: tuple[Path, ...] = ()) -> Sweep:
     if not isinstance(name, str) or not name:
         raise DelveError(f"name: must be a non-empty string, not {short_repr(name)}", path, doc.key_line("name"))
     seeds, grid = _seeds(doc, path), _grid(doc, path)
-    entries = _run_entries(doc, path, _scenario_files(doc, path))
-    for _, files, _ in entries:
-        for file, line in files:
-            _check_allowed(file, path, line, include_path)
+    entries = _run_entries(doc, path, _scenario_files(doc, path, include_path), include_path)
     total = sum(len(files) for _, files, _ in entries) * math.prod(map(len, grid)) * max(1, len(seeds))
     if total > MAX_RUNS:
         raise DelveError(f"sweep: {total:,} runs, more than the limit of {MAX_RUNS:,}", path, doc.line)
@@ -156,6 +155,7 @@ def load_sweep(path: str | Path, include_path: tuple[Path, ...] = ()) -> Sweep:
                     scenario = apply_overrides(docs[file], overrides)
                 except DelveError as err:
                     raise DelveError(err.message, path, err.line) from None
+                _check_world_files(scenario, file, path, file_line, include_path)
                 checked = _generated(file, docs[file], overrides, (path, file_line), include_path)
                 for seed in seeds or [checked.seed]:
                     runs.append(RunSpec(
@@ -205,40 +205,54 @@ def _known_keys(doc: YamlDict, allowed: tuple[str, ...], where: str, path: Path)
                              f"(one of {', '.join(allowed)})", path, doc.key_line(key))
 
 
-def _scenario_files(doc: YamlDict, path: Path) -> list[tuple[Path, int | None]]:
+def _scenario_files(doc: YamlDict, path: Path, include_path: tuple[Path, ...]) -> list[tuple[Path, int | None]]:
     """The ``scenarios:`` files, relative to the sweep file, with their lines."""
     given, line = doc.get("scenarios", []), doc.key_line("scenarios")
     items = [given] if isinstance(given, str) else given
     if not isinstance(items, list):
         raise DelveError("scenarios: must be a list of scenario files", path, line)
-    return [_scenario_file(item, path, items.item_line(i) if isinstance(items, YamlList) else line, "scenarios")
-            for i, item in enumerate(items)]
+    return [_scenario_file(item, path, items.item_line(i) if isinstance(items, YamlList) else line, "scenarios",
+                           include_path) for i, item in enumerate(items)]
 
 
-def _scenario_file(item: Any, path: Path, line: int | None, where: str) -> tuple[Path, int | None]:
+def _scenario_file(item: Any, path: Path, line: int | None, where: str,
+                   include_path: tuple[Path, ...]) -> tuple[Path, int | None]:
     if not isinstance(item, str) or not item:
         raise DelveError(f"{where}: a scenario file name, not {short_repr(item)}", path, line)
     file = path.parent / item
     shipped = SCENARIOS_DIR / f"{item}.yaml"
     if not file.exists() and "/" not in item and not Path(item).suffix and shipped.is_file():
         file = shipped   # a shipped scenario by its name, as `delve run demo`
+    _check_allowed(file, path, line, include_path)   # first: nothing said of a file elsewhere
     problem = file_problem(file)
     if problem:
         raise DelveError(f"{where}: scenario file {problem}: {short_repr(item)[1:-1]}", path, line)
     return file, line
 
 
-def _check_allowed(file: Path, path: Path, line: int | None, include_path: tuple[Path, ...]) -> None:
-    """A scenario file must lie, symbolic links followed, in the sweep's folder, the shipped
-    scenarios or an ``include_path`` folder (as a tree's file must): a sweep file from
-    elsewhere cannot have delve read, and quote in its errors, any file of the machine."""
-    roots = dict.fromkeys([os.path.realpath(path.parent), os.path.realpath(SCENARIOS_DIR),
-                           *(os.path.realpath(p) for p in include_path)])
-    if not any(path_inside(os.path.realpath(file), root) for root in roots):
+def _check_allowed(file: Path, path: Path, line: int | None, include_path: tuple[Path, ...],
+                   what: str = "scenario", scenario: Path | None = None) -> None:
+    """A file a sweep makes delve read (a scenario, a world file of one) must lie, symbolic
+    links followed, in the sweep's folder, the ``scenario``'s folder, the shipped scenarios
+    or an ``include_path`` folder (as a tree's file must): a sweep file from elsewhere
+    cannot have delve read, and quote in its errors, any file of the machine."""
+    folders = [path.parent, *([scenario.parent] if scenario is not None else []), SCENARIOS_DIR, *include_path]
+    if not any(path_inside(os.path.realpath(file), os.path.realpath(f)) for f in folders):
         given = file.relative_to(path.parent) if file.is_relative_to(path.parent) else file
-        raise DelveError(f"scenario {short_repr(str(given))} is outside the allowed folders (the sweep's folder "
-                         f"{os.path.join(display_path(path.parent), '')}, the shipped scenarios; add --include-path)",
-                         path, line)
+        also = " and the scenario's" if scenario is not None else ""
+        raise DelveError(f"{what} {short_repr(str(given))} is outside the allowed folders (the sweep's folder "
+                         f"{os.path.join(display_path(path.parent), '')}{also}, the shipped scenarios; add "
+                         "--include-path)", path, line)
+
+
+def _check_world_files(scenario: Any, file: Path, path: Path, line: int | None,
+                       include_path: tuple[Path, ...]) -> None:
+    """:func:`_check_allowed` for the files the generated scenario's world names (relative
+    to the scenario ``file``), before any is read."""
+    world = scenario.get("world") if isinstance(scenario, dict) else None
+    for key in WORLD_FILE_KEYS if isinstance(world, dict) else ():
+        if isinstance(world.get(key), str):
+            _check_allowed(file.parent / world[key], path, line, include_path, f"world.{key}", file)
 
 
 def _seeds(doc: YamlDict, path: Path) -> list[int]:
@@ -311,8 +325,8 @@ def _grid(doc: YamlDict, path: Path) -> list[list[Override]]:
     return axes
 
 
-def _run_entries(doc: YamlDict, path: Path, scenarios: list[tuple[Path, int | None]]
-                 ) -> list[tuple[str | None, list[tuple[Path, int | None]], tuple[Override, ...]]]:
+def _run_entries(doc: YamlDict, path: Path, scenarios: list[tuple[Path, int | None]],
+                 include_path: tuple[Path, ...]) -> list[tuple[str | None, list[tuple[Path, int | None]], tuple[Override, ...]]]:
     """Each ``runs:`` entry (or one empty entry when there is none) as its label, its
     scenario files (its own ``scenario:``, else ``scenarios:``) and its overrides."""
     given = doc.get("runs")
@@ -332,7 +346,7 @@ def _run_entries(doc: YamlDict, path: Path, scenarios: list[tuple[Path, int | No
         label = entry.get("label")
         if label is not None and (not isinstance(label, str) or not label):
             raise DelveError(f"runs/{i}: label must be a non-empty string", path, entry.key_line("label"))
-        files = ([_scenario_file(entry["scenario"], path, entry.key_line("scenario"), f"runs/{i}")]
+        files = ([_scenario_file(entry["scenario"], path, entry.key_line("scenario"), f"runs/{i}", include_path)]
                  if "scenario" in entry else scenarios)
         if not files:
             raise DelveError(f"runs/{i}: no scenario: give 'scenario:' here or 'scenarios:' at the top", path, line)

@@ -2,7 +2,6 @@
 voxel maps, a radio with path loss and breadcrumbs, coverage of the free volume."""
 from __future__ import annotations
 
-import os
 from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Mapping
@@ -75,7 +74,7 @@ class VoxelBackend(WorldBackend):
                 if problem and problem != "is a directory":  # a folder: a Gazebo model
                     raise DelveError(f"mesh file {problem}: {short_repr(str(given))[1:-1]}", scenario.path,
                                      where.key_line("mesh"))
-                mesh = Path(os.path.abspath(given))   # a symbolic link keeps the name the user gave
+                mesh = given.resolve()
                 spec.pop("seed", None)
                 if "trajectory" in spec:
                     given = spec["trajectory"]
@@ -83,7 +82,7 @@ class VoxelBackend(WorldBackend):
                     if problem:
                         raise DelveError(f"trajectory file {problem}: {short_repr(given)[1:-1]}", scenario.path,
                                          where.key_line("trajectory"))
-                    spec["trajectory"] = Path(os.path.abspath(scenario.path.parent / given))
+                    spec["trajectory"] = (scenario.path.parent / given).resolve()
                 seeds = [r.start for r in scenario.robots if r.start is not None]
                 return from_file(mesh, seeds=seeds, **spec)
             generate = cls.generators()[spec.pop("generator")]

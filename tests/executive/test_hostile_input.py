@@ -272,13 +272,3 @@ def test_a_broken_mesh_prints_only_delves_line(capfd):
     out, err = capfd.readouterr()
     assert out == ""
     assert err.count("\n") == 1 and "cannot read mesh 'broken_mesh.ply'" in err, err
-
-
-def test_a_mesh_behind_a_symbolic_link_is_named_as_the_scenario_names_it(tmp_path, capfd):
-    (tmp_path / "scan_2026_11_30.ply").write_bytes((DATA / "malformed_scenarios" / "broken_mesh.ply").read_bytes())
-    (tmp_path / "cave.ply").symlink_to("scan_2026_11_30.ply")
-    path = write(tmp_path, "s.yaml", "name: s\nworld:\n  mesh: cave.ply\n  voxel_size_m: 0.5\nrobots:\n"
-                                     f"  - {{name: a, platform: legged, tree: {TREES_DIR / 'frontier_explorer.yaml'}}}\n")
-    assert main(["validate", str(path)]) == 2
-    err = capfd.readouterr().err
-    assert "s.yaml:3: world: cannot read mesh 'cave.ply'" in err and "scan_2026" not in err, err

@@ -94,7 +94,10 @@ def test_overrides_make_missing_mappings_and_index_lists():
 @pytest.mark.parametrize("text, line, expect", [
     ("scenarios: [SMALL]\ngird: {}\n", 2, "sweep: unknown key 'gird' (did you mean 'grid'?)"),
     ("scenarios: [nope.yaml]\n", 1, "scenarios: scenario file not found: nope.yaml"),
-    ("scenarios: [/etc]\n", 1, "scenarios: scenario file is a directory: /etc"),
+    ("scenarios: [SMALL, sub]\n", 1, "scenarios: scenario file is a directory: sub"),
+    ("scenarios: [/etc]\n", 1, "scenario '/etc' is outside the allowed folders"),
+    ("scenarios: [SMALL]\nruns:\n  - set: {world: {mesh: ../elsewhere.yaml}}\n", 1,
+     "world.mesh '../elsewhere.yaml' is outside the allowed folders (the sweep's folder "),
     ("scenarios: [../elsewhere.yaml]\n", 1, "scenario '../elsewhere.yaml' is outside the allowed folders"),
     ("runs:\n  - {scenario: ../elsewhere.yaml, set: {}}\n", 2, "scenario '../elsewhere.yaml' is outside the "),
     ("scenarios: [SMALL]\nseeds: [1, -2]\n", 2, "seeds/1: a seed is an integer from 0 to 9223372036854775807, not -2"),
@@ -113,8 +116,9 @@ def test_overrides_make_missing_mappings_and_index_lists():
     ("- a\n", 1, "a sweep file must be a mapping"),
 ])
 def test_a_mistake_is_one_line_at_its_key(tmp_path, capsys, text, line, expect):
-    (tmp_path.parent / "elsewhere.yaml").write_text("secret: 1\n")   # readable, but not the sweep's to read
-    path = sweep_file(tmp_path, text)
+    (tmp_path / "elsewhere.yaml").write_text("secret: 1\n")   # readable, but not the sweep's to read
+    (tmp_path / "sweep" / "sub").mkdir(parents=True)
+    path = sweep_file(tmp_path / "sweep", text)
     err = cli_error(path, capsys)
     assert err.startswith(f"{path}:{line}: ") or err.startswith(f"{path.name}:{line}: "), err
     assert expect in err, err
