@@ -37,11 +37,10 @@ from delve.executive.scenario import load_scenario
 from delve.planners import frontier, navgraph
 from delve.planners.frontier_incremental import FrontierUpdater
 from delve.planners import navgraph_incremental
-from delve.planners.navgraph_incremental import LeggedGraphUpdater
 from delve.sim import robot as robot_mod
 from delve.sim.voxel_map import VoxelMap
 from delve.sim.world import World
-from delve.skills import exploration, navigation
+from delve.skills import exploration
 
 try:
     from delve.planners.cops.extraction_incremental import ExtractionUpdater
@@ -79,11 +78,10 @@ def timed(owner, attr: str, bucket: str) -> None:
 def instrument() -> None:
     timed(World, "cast_rays", "ray casting")
     timed(VoxelMap, "integrate_scan", "map integration")
-    for mod in (navigation, navgraph):
-        timed(mod, "aerial_graph", "planning")
+    timed(navgraph, "aerial_graph", "planning")
     timed(navgraph, "legged_graph", "planning")
-    timed(LeggedGraphUpdater, "update", "planning")
-    timed(getattr(navgraph_incremental, "AerialGraphUpdater", None), "update", "planning")
+    for updater in ("LeggedGraphUpdater", "AerialGraphUpdater"):   # AerialGraphUpdater: not in a baseline before it
+        timed(getattr(navgraph_incremental, updater, None), "update", "planning")
     timed(FrontierUpdater, "update", "planning")
     timed(navgraph.NavGraph, "shortest_paths", "planning")
     for mod in (exploration, frontier):

@@ -222,7 +222,7 @@ class AerialGraphUpdater:
         s = self.stride
         ijk = np.stack(np.unravel_index(flat, self._shape), axis=1) % s
         parts = []
-        for cls in {tuple(c) for c in np.unique(ijk, axis=0)}:
+        for cls in np.unique(ijk, axis=0):
             offsets = [d for d in self._ball if all((c + o) % s == 0 for c, o in zip(cls, d))]
             if offsets:
                 parts.append(around(flat[np.all(ijk == cls, axis=1)], self._shape, offsets))

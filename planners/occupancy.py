@@ -8,8 +8,8 @@ A grid is an int8 array (nx, ny, nz) with values :data:`UNKNOWN`, :data:`FREE` a
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 import numpy as np
 

@@ -96,16 +96,14 @@ class CloudDirections:
         self.tree = cKDTree(d / self.range_m[:, None])
 
 
-def behind_observed(sphere: np.ndarray, cloud: np.ndarray | CloudDirections, agent: np.ndarray,
-                    width_m: float) -> np.ndarray:
-    """(M,) bool: sphere points straight behind an observed point, within the angle that half of
-    ``width_m`` subtends at the range of the cloud point nearest in direction. With the width of a
-    voxel they are hidden (give or take half a voxel at the rim of an opening), so leaving them out
-    of the hull changes little but its cost: in a drift most of the sphere is behind the walls, and
+def behind_observed(sphere: np.ndarray, seen: CloudDirections, agent: np.ndarray, width_m: float) -> np.ndarray:
+    """(M,) bool: sphere points straight behind an observed point (``seen``: the observed
+    points' directions from ``agent``), within the angle that half of ``width_m`` subtends at
+    the range of the cloud point nearest in direction. With the width of a voxel they are
+    hidden (give or take half a voxel at the rim of an opening), so leaving them out of the
+    hull changes little but its cost: in a drift most of the sphere is behind the walls, and
     qhull takes about a third less time without it. With eta_disc, gaps narrower than a
-    discontinuity in the observed surface count as closed. ``cloud``: the observed points, or their
-    :class:`CloudDirections` from ``agent``."""
-    seen = cloud if isinstance(cloud, CloudDirections) else CloudDirections(cloud, agent)
+    discontinuity in the observed surface count as closed."""
     r = seen.range_m
     u = (sphere - agent) / np.linalg.norm(sphere - agent, axis=1)[:, None]
     gap, near = seen.tree.query(u, distance_upper_bound=0.5 * width_m / r.min())
@@ -242,5 +240,5 @@ def triangle_geometry(mesh: FrontierMesh) -> tuple[np.ndarray, np.ndarray, np.nd
     return centroids, n, 0.5 * twice_area
 
 
-__all__ = ["MIN_POINTS", "behind_observed", "blind_sphere_points", "exponential_inversion", "sphere_points",
-           "split_long_edges", "triangle_geometry", "visible_mesh"]
+__all__ = ["MIN_POINTS", "CloudDirections", "behind_observed", "blind_sphere_points", "exponential_inversion",
+           "sphere_points", "split_long_edges", "triangle_geometry", "visible_mesh"]

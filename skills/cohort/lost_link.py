@@ -93,8 +93,8 @@ class ReturnToLinkPoint(GoTo):
     """
 
     PARAMS = {**{k: v for k, v in GoTo.PARAMS.items() if k not in ("goal", "goal_key")},
-              "planner": Param(str, "gbplanner", "GBPlanner2's global graph (the way the robot came; the navigation "
-                               "graph where it has no path), or the navigation graph of the onboard map",
+              "planner": Param(str, "gbplanner", "gbplanner: GBPlanner2's global graph, the way the robot came (the "
+                               "navigation graph where it has no path); navigator: the onboard map's navigation graph",
                                choices=("gbplanner", "navigator")),
               "ping_attempts": Param(int, 3, "pings tried at a point before it counts as without link", minimum=1),
               "ping_every_s": Param(float, 2.0, "on the way, one ping this often; an answer ends the way back",

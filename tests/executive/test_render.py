@@ -5,10 +5,11 @@ import shutil
 from pathlib import Path
 
 import py_trees
+import pydot
 import pytest
 from py_trees.common import Status
 from delve.executive.errors import DelveError
-from delve.executive.render import _ascii_memory_mark, dot_graph, render_tree, text_tree
+from delve.executive.render import dot_graph, render_tree, text_tree
 from delve.executive.tree_loader import load_tree
 from delve.skills.base import AgentContext
 
@@ -102,14 +103,15 @@ def test_graph_formats(ticked_tree, tmp_path, fmt, magic):
     assert magic in out.read_bytes()[:400]
 
 
-def test_a_png_marks_memory_in_ascii_the_other_formats_as_py_trees_does():
-    steps = py_trees.composites.Sequence("Steps", memory=True,
-                                         children=[py_trees.behaviours.Success("Step")])
-    graph = dot_graph(steps)
-    memory = py_trees.display.unicode_symbols["memory"]
-    assert memory in graph.get_node("Steps")[0].get("label")
-    _ascii_memory_mark(graph)
-    assert graph.get_node("Steps")[0].get("label").strip('"').startswith("M Steps")
+@pytest.mark.parametrize("fmt, mark", [("png", "M Steps"), ("svg", "\u24c2 Steps"), ("dot", "\u24c2 Steps")])
+def test_a_png_marks_memory_in_ascii_the_other_formats_as_py_trees_does(tmp_path, monkeypatch, fmt, mark):
+    """graphviz draws a PNG with the machine's fonts, which often lack py_trees' Ⓜ."""
+    drawn = {}
+    monkeypatch.setattr(pydot.Dot, "write", lambda graph, path, format: drawn.setdefault("label", graph.get_node(
+        "Steps")[0].get("label")))
+    steps = py_trees.composites.Sequence("Steps", memory=True, children=[py_trees.behaviours.Success("Step")])
+    render_tree(steps, fmt, tmp_path / f"t.{fmt}")
+    assert drawn["label"].strip('"').startswith(mark)
 
 
 def test_unknown_format(ticked_tree, tmp_path):

@@ -6,9 +6,9 @@ from scipy.spatial import cKDTree
 from delve.planners.csiro.params import CsiroFrontierParams
 from delve.planners.csiro.point_cache import PointCache
 from delve.planners.csiro.sequential import SequentialFrontiers
-from delve.planners.csiro.visibility_mesh import (behind_observed, blind_sphere_points, exponential_inversion,
-                                                  sphere_points, split_long_edges, triangle_geometry,
-                                                  visible_mesh)
+from delve.planners.csiro.visibility_mesh import (CloudDirections, behind_observed, blind_sphere_points,
+                                                  exponential_inversion, sphere_points, split_long_edges,
+                                                  triangle_geometry, visible_mesh)
 
 from .frontier_clouds import banded_scan, box, corridor, rectangle, room_with_doorway
 
@@ -92,7 +92,7 @@ def test_a_shaft_straight_above_is_a_frontier_only_for_a_robot_that_sees_into_it
 def test_sphere_points_straight_behind_an_observed_point_are_left_out_of_the_hull():
     wall = rectangle((3.0, -1.05, -1.05), (0, 2, 0), (0, 0, 2))
     s = sphere_points(np.zeros(3), P)
-    behind = behind_observed(s, wall, np.zeros(3), P.d_vox_m)
+    behind = behind_observed(s, CloudDirections(wall, np.zeros(3)), np.zeros(3), P.d_vox_m)
     direction = s / P.d_max_m
     inside = (direction[:, 0] > 0) & (np.abs(direction[:, 1] / direction[:, 0]) < 0.3) & \
         (np.abs(direction[:, 2] / direction[:, 0]) < 0.3)
