@@ -132,14 +132,9 @@ class LeggedGraphUpdater:
                                             around(rock, sh, _negated(self._body))]))
         node = _store(self.node, node, self._where_free(occ, node, self._nodes, among=self.standable))
         sources = around(node, sh, [(0, 0, 0)] + _negated(self._offsets + self._sides))
-        src, dst, w = self._edges
-        with _Lookup(len(self.node), sources) as redo:
-            keep = redo[src] == 0
-        q = Voxels(sources, grid.shape)
-        new = self._edges_from(q.subset(self.node[sources] > 0))
-        self._edges = src, dst, w = (np.concatenate([src[keep], new[0]]), np.concatenate([dst[keep], new[1]]),
-                                     np.concatenate([w[keep], new[2]]))
-        return self._graph(grid, src, dst, w)
+        self._edges = _renewed(self._edges, sources, self._edges_from(Voxels(sources[self.node[sources] > 0], sh)),
+                               len(self.node))
+        return _numbered(grid, self.node, self._edges, self.body_height_m - 0.5 * self._vox)
 
     def _where_free(self, occ: np.ndarray, flat: np.ndarray, rule, among: np.ndarray | None = None) -> np.ndarray:
         """A rule's conclusion for the voxels ``flat``: False where a voxel is not free (or
@@ -149,17 +144,6 @@ class LeggedGraphUpdater:
             out &= among[flat] > 0
         out[out] = rule(occ, Voxels(flat[out], self._shape))
         return out
-
-    def _graph(self, grid: Grid, src: np.ndarray, dst: np.ndarray, w: np.ndarray) -> NavGraph:
-        """The nodes in the map's order of free voxels, numbered, and their edges."""
-        free = grid.free_voxels()   # only the nodes' positions are needed, not Voxels of all free ones
-        nodes = free[self.node[free] > 0]
-        positions = grid.to_world(np.stack(np.unravel_index(nodes, grid.shape), axis=1))
-        positions[:, 2] += self.body_height_m - 0.5 * self._vox
-        n = len(nodes)
-        with _Lookup(len(self.node), nodes) as ids:
-            rows, cols = ids[src].astype(np.int64) - 1, ids[dst].astype(np.int64) - 1
-        return NavGraph(positions=positions, adjacency=csr_matrix((w, (rows, cols)), shape=(n, n)))
 
 
 class AerialGraphUpdater:
@@ -197,19 +181,9 @@ class AerialGraphUpdater:
         test = distinct(sh, np.concatenate([self._on_lattice(changed), self._lattice_around(rock)]))
         node = _store(self.node, test, self._is_node(occ, test))
         sources = around(node, sh, [(0, 0, 0)] + _negated(self._offsets))
-        src, dst, w = self._edges
-        with _Lookup(len(self.node), sources) as redo:
-            keep = redo[src] == 0
-        new = self._edges_from(Voxels(sources[self.node[sources] > 0], sh))
-        self._edges = src, dst, w = (np.concatenate([src[keep], new[0]]), np.concatenate([dst[keep], new[1]]),
-                                     np.concatenate([w[keep], new[2]]))
-        free = grid.free_voxels()
-        nodes = free[self.node[free] > 0]
-        n = len(nodes)
-        with _Lookup(len(self.node), nodes) as ids:
-            rows, cols = ids[src].astype(np.int64) - 1, ids[dst].astype(np.int64) - 1
-        positions = grid.to_world(np.stack(np.unravel_index(nodes, sh), axis=1))
-        return NavGraph(positions=positions, adjacency=csr_matrix((w, (rows, cols)), shape=(n, n)))
+        self._edges = _renewed(self._edges, sources, self._edges_from(Voxels(sources[self.node[sources] > 0], sh)),
+                               len(self.node))
+        return _numbered(grid, self.node, self._edges)
 
     def _on_lattice(self, flat: np.ndarray) -> np.ndarray:
         ijk = np.unravel_index(flat, self._shape)
@@ -250,6 +224,32 @@ class AerialGraphUpdater:
             dst.append(s + (d[0] * ny + d[1]) * nz + d[2])
             w.append(np.full(len(s), self._vox * math.sqrt(d[0] ** 2 + d[1] ** 2 + d[2] ** 2)))
         return np.concatenate(src), np.concatenate(dst), np.concatenate(w)
+
+
+Edges = tuple[np.ndarray, np.ndarray, np.ndarray]
+
+
+def _renewed(edges: Edges, sources: np.ndarray, new: Edges, size: int) -> Edges:
+    """The edges (source flat, target flat, length, over a grid of ``size`` voxels) without
+    those from ``sources``, and the ``new`` ones made from them."""
+    src, dst, w = edges
+    with _Lookup(size, sources) as redo:
+        keep = redo[src] == 0
+    return np.concatenate([src[keep], new[0]]), np.concatenate([dst[keep], new[1]]), np.concatenate([w[keep], new[2]])
+
+
+def _numbered(grid: Grid, node: np.ndarray, edges: Edges, lift_m: float = 0.0) -> NavGraph:
+    """The graph of the ``node`` voxels, numbered in the map's order of free voxels as the
+    whole-map build numbers them, at their centres raised ``lift_m``, with the ``edges``."""
+    free = grid.free_voxels()   # only the nodes' positions are needed, not Voxels of all free ones
+    nodes = free[node[free] > 0]
+    positions = grid.to_world(np.stack(np.unravel_index(nodes, grid.shape), axis=1))
+    if lift_m:
+        positions[:, 2] += lift_m
+    n = len(nodes)
+    with _Lookup(len(node), nodes) as ids:
+        rows, cols = ids[edges[0]].astype(np.int64) - 1, ids[edges[1]].astype(np.int64) - 1
+    return NavGraph(positions=positions, adjacency=csr_matrix((edges[2], (rows, cols)), shape=(n, n)))
 
 
 def _store(state: np.ndarray, flat: np.ndarray, value: np.ndarray) -> np.ndarray:
