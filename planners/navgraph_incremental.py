@@ -22,7 +22,28 @@ from .navgraph import (_NEIGHBOURS_8, NavGraph, Voxels, _ball, _Lookup, around, 
 from .occupancy import FREE, OCCUPIED, UNKNOWN, Grid
 
 
-class LeggedGraphUpdater:
+class _Updater:
+    """What both updaters share: their per-voxel state made (``_setup``) for a grid, and
+    the changed voxels followed into the rule that comes first, rock."""
+
+    _shape: tuple[int, int, int] | None = None
+    rock: np.ndarray
+
+    def _setup(self, grid: Grid) -> None:
+        raise NotImplementedError
+
+    def _changes(self, grid: Grid, changed: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(occupancy, the changed voxels, those of them that turned rock or not rock): all
+        known voxels when ``changed`` is None or for a grid of another shape (state made anew)."""
+        occ = grid.occupancy.reshape(-1)
+        if changed is None or self._shape != grid.shape:
+            self._setup(grid)
+            changed = np.flatnonzero(occ != UNKNOWN)
+        changed = np.asarray(changed, dtype=np.int64)
+        return occ, changed, _store(self.rock, changed, occ[changed] == OCCUPIED)
+
+
+class LeggedGraphUpdater(_Updater):
     """The legged navigation graph of one map, updated from its changed voxels.
 
     Takes the parameters of :func:`delve.planners.navgraph.legged_graph`. Memory: four
@@ -37,7 +58,6 @@ class LeggedGraphUpdater:
         self.max_inclination_deg, self.inclination_baseline_m = max_inclination_deg, inclination_baseline_m
         self.headroom_m = body_height_m + 0.2 if headroom_m is None else headroom_m
         self.ground_inference_radius_m = ground_inference_radius_m
-        self._shape: tuple[int, int, int] | None = None
 
     def _setup(self, grid: Grid) -> None:
         """The rules' offsets for this grid's voxel size, and empty per-voxel state (that
@@ -115,13 +135,8 @@ class LeggedGraphUpdater:
         """The graph of ``grid`` after the voxels ``changed`` (flat indices) changed since
         the last update; from every known voxel when ``changed`` is None or on the first
         update (or for a grid of another shape)."""
-        occ = grid.occupancy.reshape(-1)
-        if changed is None or self._shape != grid.shape:
-            self._setup(grid)
-            changed = np.flatnonzero(occ != UNKNOWN)
-        changed = np.asarray(changed, dtype=np.int64)
+        occ, changed, rock = self._changes(grid, changed)
         sh = self._shape
-        rock = _store(self.rock, changed, occ[changed] == OCCUPIED)
         ground = around(changed, sh, [(0, 0, 0), (0, 0, 1)])
         q = Voxels(ground, sh)
         ground = _store(self.ground, ground, (occ[ground] == FREE) & (q.at(occ, (0, 0, -1), UNKNOWN) == OCCUPIED))
@@ -146,7 +161,7 @@ class LeggedGraphUpdater:
         return out
 
 
-class AerialGraphUpdater:
+class AerialGraphUpdater(_Updater):
     """The aerial navigation graph of one map (:func:`delve.planners.navgraph.aerial_graph`
     with its parameters), updated from its changed voxels. A node is a free voxel of the
     lattice with no rock within the robot's radius: only voxels that turned free or not
@@ -155,7 +170,6 @@ class AerialGraphUpdater:
 
     def __init__(self, *, radius_m: float, stride: int = 2):
         self.radius_m, self.stride = radius_m, stride
-        self._shape: tuple[int, int, int] | None = None
 
     def _setup(self, grid: Grid) -> None:
         """The rules' offsets for this grid's voxel size, and the state of an unknown map."""
@@ -171,13 +185,8 @@ class AerialGraphUpdater:
         """The graph of ``grid`` after the voxels ``changed`` (flat indices) changed since
         the last update; from every known voxel when ``changed`` is None or on the first
         update (or for a grid of another shape)."""
-        occ = grid.occupancy.reshape(-1)
-        if changed is None or self._shape != grid.shape:
-            self._setup(grid)
-            changed = np.flatnonzero(occ != UNKNOWN)
-        changed = np.asarray(changed, dtype=np.int64)
+        occ, changed, rock = self._changes(grid, changed)
         sh = self._shape
-        rock = _store(self.rock, changed, occ[changed] == OCCUPIED)
         test = distinct(sh, np.concatenate([self._on_lattice(changed), self._lattice_around(rock)]))
         node = _store(self.node, test, self._is_node(occ, test))
         sources = around(node, sh, [(0, 0, 0)] + _negated(self._offsets))
