@@ -90,7 +90,8 @@ def write_table(table: pd.DataFrame, out: Path) -> list[Path]:
 
 
 def figure_columns(table: pd.DataFrame, sweep: Sweep) -> list[str]:
-    """The report's figures worth a plot: numbers or truths that differ between runs."""
+    """The report's figures worth a plot: numbers or truths that differ between runs (or
+    that some runs have and others not, such as a coverage only some reach)."""
     skip = set(RUN_COLUMNS) | set(sweep.override_paths)
     ok = table[table["status"] == "ok"]
     figures = []
@@ -99,7 +100,7 @@ def figure_columns(table: pd.DataFrame, sweep: Sweep) -> list[str]:
             continue
         values = ok[column].dropna().infer_objects()
         numeric = pd.api.types.is_numeric_dtype(values) or pd.api.types.is_bool_dtype(values)
-        if len(values) and numeric and values.nunique() > 1:
+        if len(values) and numeric and (values.nunique() > 1 or len(values) < len(ok)):
             figures.append(column)
     return figures
 
@@ -140,11 +141,17 @@ def plot_figures(table: pd.DataFrame, sweep: Sweep, folder: Path) -> list[Path]:
 
 
 def _plot_one(figure: str, values: pd.Series, groups: pd.Series, order: list[str], failed: int, path: Path) -> None:
-    fig, ax = plt.subplots(figsize=(max(5.0, 1.2 * len(order) + 2.0), 4.2))
+    fig, ax = plt.subplots(figsize=(max(6.5, 1.2 * len(order) + 2.0), 4.6))
     truth = pd.api.types.is_bool_dtype(values.dropna().infer_objects())
     x = np.arange(len(order))
+    blank = False
     for i, group in enumerate(order):
-        ys = values[groups == group].dropna().astype(float).to_numpy()
+        runs = values[groups == group]
+        ys = runs.dropna().astype(float).to_numpy()
+        if len(ys) < len(runs):   # e.g. a coverage never reached: said, not hidden in the median
+            blank = True
+            ax.text(i, 0.02, f"{len(runs) - len(ys)} of {len(runs)}:\nno value", transform=ax.get_xaxis_transform(),
+                    ha="center", va="bottom", fontsize=7, color="dimgray")
         if truth:
             ax.bar(i, ys.mean() if len(ys) else 0.0, width=0.6, color="tab:blue", alpha=0.7)
             ax.text(i, ys.mean() if len(ys) else 0.0, f"{int(ys.sum())}/{len(ys)}", ha="center", va="bottom")
@@ -154,16 +161,18 @@ def _plot_one(figure: str, values: pd.Series, groups: pd.Series, order: list[str
         # Spread points of one group a little so that equal values stay visible (no randomness).
         spread = np.linspace(-0.12, 0.12, len(ys)) if len(ys) > 1 else np.zeros(len(ys))
         ax.scatter(i + spread, ys, s=22, color="tab:blue", alpha=0.8, zorder=3)
-        if len(ys):
+        if 2 * len(ys) > len(runs):   # the median of the runs with a value is the group's
             ax.hlines(np.median(ys), i - 0.25, i + 0.25, color="tab:red", lw=2, zorder=4)
-    ax.set_xticks(x, order, fontsize=8)
+    long_labels = max(map(len, order), default=0) > 14
+    ax.set_xticks(x, order, fontsize=8, rotation=25 if long_labels else 0, ha="right" if long_labels else "center")
     ax.set_xlim(-0.6, len(order) - 0.4)
     ax.set_ylabel(f"share of runs where {figure}" if truth else figure)
     if truth:
         ax.set_ylim(0, 1.1)
     what = "bar: share of runs (count above)" if truth else "each point one seed, red bar: median"
-    note = f"; {failed} failed run(s) left out" if failed else ""
-    ax.set_title(f"{figure}\n{what}{note}", fontsize=10)
+    notes = [f"{failed} failed run(s) left out"] if failed else []
+    notes += ["runs with no value: counted at the foot, no median if half or more"] if blank else []
+    ax.set_title("\n".join([figure, what, "; ".join(notes)] if notes else [figure, what]), fontsize=9)
     ax.grid(axis="y", alpha=0.3)
     fig.tight_layout()
     fig.savefig(path, dpi=100)

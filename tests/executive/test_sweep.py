@@ -4,6 +4,7 @@ missions on a LocalCluster are in tests/scenarios/test_sweep.py."""
 import json
 from pathlib import Path
 
+import matplotlib.figure
 import pandas as pd
 import pytest
 
@@ -214,6 +215,21 @@ def test_one_plot_per_figure_that_varies(tmp_path):
     written = plot_figures(table, sweep, tmp_path / "plots")
     assert [p.name for p in written] == ["succeeded.png", "coverage_fraction.png"]
     assert all(p.stat().st_size > 1000 for p in written)
+
+
+def test_runs_without_a_value_are_counted_under_their_group_and_leave_no_median(tmp_path, monkeypatch):
+    """A coverage never reached has no time: the plot says how many, not a median of the rest."""
+    sweep, records, runs_dir = fake_sweep(tmp_path)
+    last = runs_dir / sweep.runs[3].run_id / "report.json"
+    last.write_text(json.dumps(dict(json.loads(last.read_text()), coverage_reached_s={"80%": 120.0, "90%": None})))
+    drawn = {}
+    monkeypatch.setattr(matplotlib.figure.Figure, "savefig", lambda fig, path, **kw: drawn.setdefault(
+        Path(path).name, ([t.get_text() for t in fig.axes[0].texts], len(fig.axes[0].collections))))
+    plot_figures(results_table(sweep, records, runs_dir), sweep, tmp_path / "plots")
+    texts, _ = drawn["coverage_reached_s.80_.png"]
+    assert texts == ["1 of 1:\nno value", "1 of 2:\nno value"]     # range 30 (one failed run), range 60
+    _, with_value = drawn["coverage_fraction.png"]
+    assert with_value > 0
 
 
 def test_a_whole_list_can_be_overridden(tmp_path):
