@@ -45,12 +45,24 @@ def run_one(spec: RunSpec, folder: Path) -> dict[str, Any]:
             status, error, wall_s = "ok", "", rep["wall_time_s"]
         except Exception as err:  # noqa: BLE001 - any failure of one run is recorded, never raised
             (folder / "error.txt").write_text(traceback.format_exc())
-            status, error, wall_s = "failed", one_line(err), round(time.perf_counter() - started, 3)
+            status, error, wall_s = "failed", one_line(err) + _overrides_note(spec, err), round(
+                time.perf_counter() - started, 3)
     record = {"run_id": spec.run_id, "digest": spec.digest, "status": status, "error": error, "wall_time_s": wall_s}
     partial = folder / f".{MARKER}.part"
     partial.write_text(json.dumps(record, indent=2) + "\n")
     os.replace(partial, folder / MARKER)
     return record
+
+
+def _overrides_note(spec: RunSpec, err: BaseException) -> str:
+    """For a mistake a scenario's check found in a run with overrides: which values the
+    sweep set and at which of its lines (the error names the scenario's file and line,
+    though the value at fault may be the sweep's)."""
+    if not isinstance(err, DelveError) or not spec.overrides:
+        return ""
+    given = ", ".join(f"{o.path}={clip_message(o.value, 30)}" + (f" (sweep line {o.line})" if o.line else "")
+                      for o in spec.overrides)
+    return f" [this run's overrides: {given}]"
 
 
 def _mission(spec: RunSpec, folder: Path, started: float) -> dict[str, Any]:

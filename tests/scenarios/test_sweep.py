@@ -86,4 +86,6 @@ def test_a_second_start_runs_only_what_is_unfinished_and_a_failure_stops_nothing
     assert len(table) == 8 and (table[table["label"] != "broken"]["status"] == "ok").all()
     assert (broken["status"] == "failed").all() and broken["error"].str.contains("total_length_m").all()
     assert all("\n" not in e for e in broken["error"])
+    assert broken["error"].str.contains("this run's overrides: ").all()
+    assert broken["error"].str.contains("world.total_length_m=60 (sweep line ", regex=False).all()
     assert (runs / broken["run_id"].iloc[0] / "error.txt").read_text().startswith("Traceback")
