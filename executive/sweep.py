@@ -123,7 +123,8 @@ def progress_bar(name: str) -> Iterator[Callable[[int, int, RunSpec, dict], None
             wall = record.get("wall_time_s")
             took = f" ({wall:.1f} s)" if isinstance(wall, (int, float)) else ""
             error = f": {record['error']}" if record["status"] != "ok" else ""
-            bar.console.print(f"{spec.run_id}: {record['status']}{took}{error}", highlight=False, markup=False)
+            bar.console.print(f"{spec.run_id}: {record['status']}{took}{error}", highlight=False, markup=False,
+                              soft_wrap=True)   # one line per run, whatever the width: grep finds it
             bar.update(task, completed=done, total=total, failed=f"{failures} failed" if failures else "")
 
         yield update
