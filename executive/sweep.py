@@ -55,14 +55,27 @@ def dask_client(workers: int | None = None, scheduler: str | None = None) -> Ite
             client = Client(scheduler, timeout=CONNECT_TIMEOUT_S)
         except (OSError, TimeoutError) as err:
             raise DelveError(f"--scheduler {scheduler}: cannot connect ({clip_message(err, 100)})") from None
-        with client:
+        with client, _quiet_on_interrupt():
             yield client
         return
     # dashboard_address ":0": any free port, so that a second cluster on this machine does not warn that
     # the default one is taken.
     with LocalCluster(n_workers=workers or default_workers(), threads_per_worker=1, processes=True,
-                      dashboard_address=":0", silence_logs=logging.ERROR) as cluster, Client(cluster) as client:
+                      dashboard_address=":0", silence_logs=logging.ERROR) as cluster, Client(cluster) as client, \
+            _quiet_on_interrupt():
         yield client
+
+
+@contextmanager
+def _quiet_on_interrupt() -> Iterator[None]:
+    """On Ctrl-C, silence Dask's loggers before the client and cluster close: runs cut off
+    and heartbeats lost then are what the user asked for, not errors to show them."""
+    try:
+        yield
+    except KeyboardInterrupt:
+        for name in ("distributed", "tornado", "asyncio"):
+            logging.getLogger(name).setLevel(logging.CRITICAL + 1)
+        raise
 
 
 def run_sweep(sweep: Sweep, out: Path, *, workers: int | None = None, scheduler: str | None = None,
