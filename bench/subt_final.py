@@ -29,8 +29,10 @@ from pathlib import Path
 
 import yaml
 
-ROOT = Path(__file__).resolve().parent.parent
-SCENARIO = ROOT / "scenarios" / "subt_final.yaml"
+from delve import SCENARIOS_DIR
+
+#: The shipped scenario (a sweep reads scenarios from the shipped ones or its own folder).
+SCENARIO = SCENARIOS_DIR / "subt_final.yaml"
 #: CERBERUS's Prize Round (paper, Table 3): ANYmal run time (min), distance (m),
 #: points and operational share.
 TABLE_3 = {"ANYmal 1": (57, 240, 8, 0.311), "ANYmal 2": (60, 687, 8, 0.69), "ANYmal 3": (47, 311, 1, 0.341),
