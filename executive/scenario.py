@@ -356,6 +356,11 @@ def load_scenario(path: str | Path, include_path: Iterable[str | Path] = (),
         key = "type" if "type" in doc else "include"
         raise DelveError(f"{path.name} is a tree, not a scenario: a scenario names its trees "
                          "(robots: - tree: ...)", path, doc.key_line(key))
+    known = tuple(scenario_schema()["properties"])
+    if doc and not any(isinstance(k, str) and (k in known or did_you_mean(k, known)) for k in doc):
+        # Not a word of it: a file that is no scenario (named by mistake) is not quoted.
+        raise DelveError(f"{path.name} is no scenario: none of its keys is a scenario's ({', '.join(known[:6])}, ...)",
+                         path, doc.line)
     _nan(doc, path)
     errors = sorted(jsonschema.Draft202012Validator(scenario_schema()).iter_errors(doc), key=_schema_rank)
     if errors:

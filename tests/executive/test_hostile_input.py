@@ -272,3 +272,12 @@ def test_a_broken_mesh_prints_only_delves_line(capfd):
     out, err = capfd.readouterr()
     assert out == ""
     assert err.count("\n") == 1 and "cannot read mesh 'broken_mesh.ply'" in err, err
+
+
+def test_a_file_that_is_no_scenario_is_refused_without_a_word_of_it(tmp_path, capsys):
+    secret = "alice:$6$rounds=5000$SECRETSALT$HASH:19000:0:99999:7:::"
+    path = write(tmp_path, "shadow", secret + "\n")
+    assert main(["run", str(path), "--out", str(tmp_path / "out")]) == 2
+    line = one_line(capsys)
+    assert line.endswith("shadow:1: shadow is no scenario: none of its keys is a scenario's (name, description, "
+                         "seed, duration_s, dt_s, coverage_period_s, ...)") and "SECRET" not in line
