@@ -13,6 +13,7 @@ voxels), so the graph equals the full build's exactly.
 from __future__ import annotations
 
 import math
+from abc import ABC, abstractmethod
 
 import numpy as np
 from scipy.sparse import csr_matrix
@@ -22,15 +23,16 @@ from .navgraph import (_NEIGHBOURS_8, NavGraph, Voxels, _ball, _Lookup, around, 
 from .occupancy import FREE, OCCUPIED, UNKNOWN, Grid
 
 
-class _Updater:
+class _Updater(ABC):
     """What both updaters share: their per-voxel state made (``_setup``) for a grid, and
     the changed voxels followed into the rule that comes first, rock."""
 
     _shape: tuple[int, int, int] | None = None
     rock: np.ndarray
 
+    @abstractmethod
     def _setup(self, grid: Grid) -> None:
-        raise NotImplementedError
+        """The rules' offsets for this grid's voxel size, and the state of an unknown map."""
 
     def _changes(self, grid: Grid, changed: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(occupancy, the changed voxels, those of them that turned rock or not rock): all
