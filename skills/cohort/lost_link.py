@@ -4,6 +4,7 @@ T_C^e seconds more unless the box is explored, then go back to the last point th
 offered a link, and further back point by point if that one offers none either."""
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -85,17 +86,15 @@ class ReturnToLinkPoint(GoTo):
     navigation graph of the onboard map keeps more room around an aerial robot than
     GBPlanner2's box and found no way through squeezes the robot had flown through
     (the robot then gave up exploring). The way flown is added to GBPlanner2's global
-    graph as ``FollowHubPath`` adds its own. Reads ``cohort_link_points``; writes ``goto_failure`` as ``GoTo``. Logs
-    ``cohort_backtrack`` when it sets out, ``cohort_link_point`` at each point
-    reached (linked or not) and ``cohort_link_regained`` where a ping on the way was
-    answered. Returns RUNNING on the way; SUCCESS where the hub answers; FAILURE when
-    no point offers a link.
+    graph as ``FollowHubPath`` adds its own. Reads ``cohort_link_points``; writes
+    ``goto_failure`` as ``GoTo``. Logs ``cohort_backtrack`` when it sets out,
+    ``cohort_link_point`` at each point reached (linked or not) and
+    ``cohort_link_regained`` where a ping on the way was answered. Returns RUNNING on
+    the way; SUCCESS where the hub answers; FAILURE when no point offers a link.
     """
 
     PARAMS = {**{k: v for k, v in GoTo.PARAMS.items() if k not in ("goal", "goal_key")},
-              "planner": Param(str, "gbplanner", "gbplanner: GBPlanner2's global graph, the way the robot came (the "
-                               "navigation graph where it has no path); navigator: the onboard map's navigation graph",
-                               choices=("gbplanner", "navigator")),
+              "planner": replace(GoTo.PARAMS["planner"], default="gbplanner"),
               "ping_attempts": Param(int, 3, "pings tried at a point before it counts as without link", minimum=1),
               "ping_every_s": Param(float, 2.0, "on the way, one ping this often; an answer ends the way back",
                                     exclusive_minimum=0),
