@@ -29,10 +29,12 @@ coordination gains without its lost-link rule.
 
 Prints one row per run, then per world and method the median of: T90 (sim time to
 90 % of the world's free volume observed by the team; "not reached" counts as later
-than any time), final coverage, coverage known at the base station, the robots'
-total distance, the overlap (the share of the team's observed volume that more than
-one robot observed) and the artifacts scored; then the ratios of the issue's goals:
-COHORT(3)/single T90 (goal <= 0.5) and COHORT(3)/independent(3) T90 (goal <= 0.8).
+than any time), T90 at base (the same of what the base station knows), final
+coverage, coverage known at the base station, the robots' total distance, the overlap
+(the share of the team's observed volume that more than one robot observed) and the
+artifacts scored; then the ratios of the issue's goals:
+COHORT(3)/single T90 (goal <= 0.5) and COHORT(3)/independent(3) T90 (goal <= 0.8), and
+the same ratios of T90 at base.
 """
 from __future__ import annotations
 
@@ -89,6 +91,7 @@ class Run:
     method: str
     seed: int
     t90_s: float | None
+    base_t90_s: float | None
     coverage: float
     base_coverage: float
     distance_m: float
@@ -182,7 +185,7 @@ def run_sweep(worlds: dict[str, dict], methods: list[str], seeds: list[int], dur
         distance = sum(_number(row, f"robots.uav{i + 1}.distance_m") or 0.0 for i in range(METHODS[method][3]))
         scored = _number(row, "artifacts.scored")
         runs.append(Run(world, method, int(row["seed"]), _number(row, f"coverage_reached_s.{TARGET}"),
-                        float(row["coverage_fraction"]), float(row["base_coverage_fraction"]), distance,
+                        _number(row, f"base_coverage_reached_s.{TARGET}"), float(row["coverage_fraction"]), float(row["base_coverage_fraction"]), distance,
                         _number(row, "overlap_fraction"), None if scored is None else int(scored),
                         bool(row["succeeded"]), float(row["wall_time_s"])))
     return runs
@@ -199,28 +202,32 @@ def fmt(value: float | None, spec: str = ".0f", none: str = "-") -> str:
 
 
 def print_tables(runs: list[Run], worlds: list[str], methods: list[str]) -> None:
-    print("| world | method | seed | T90 (s) | coverage | at base | distance (m) | overlap | scored | succeeded "
-          "| wall (s) |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|")
+    print("| world | method | seed | T90 (s) | T90 at base (s) | coverage | at base | distance (m) | overlap | scored "
+          "| succeeded | wall (s) |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
     for r in sorted(runs, key=lambda r: (worlds.index(r.world), methods.index(r.method), r.seed)):
-        print(f"| {r.world} | {r.method} | {r.seed} | {fmt(r.t90_s, '.0f', 'not reached')} | {r.coverage:.1%} | "
+        print(f"| {r.world} | {r.method} | {r.seed} | {fmt(r.t90_s, '.0f', 'not reached')} | "
+              f"{fmt(r.base_t90_s, '.0f', 'not reached')} | {r.coverage:.1%} | "
               f"{r.base_coverage:.1%} | {r.distance_m:.0f} | {fmt(r.overlap, '.1%')} | {fmt(r.scored, 'd')} | "
               f"{'yes' if r.succeeded else 'no'} | {r.wall_s:.0f} |")
     print()
     print("Medians per world and method:")
     print()
-    print("| world | method | runs | T90 (s) | coverage | at base | distance (m) | overlap | scored |")
-    print("|---|---|---|---|---|---|---|---|---|")
+    print("| world | method | runs | T90 (s) | T90 at base (s) | coverage | at base | distance (m) | overlap | scored |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     medians: dict[tuple[str, str], float | None] = {}
+    base_medians: dict[tuple[str, str], float | None] = {}
     for w in worlds:
         for m in methods:
             rs = [r for r in runs if r.world == w and r.method == m]
             if not rs:
                 continue
             medians[w, m] = median_t([r.t90_s for r in rs])
+            base_medians[w, m] = median_t([r.base_t90_s for r in rs])
             overlaps = [r.overlap for r in rs if r.overlap is not None]
             scored = [r.scored for r in rs if r.scored is not None]
             print(f"| {w} | {m} | {len(rs)} | {fmt(medians[w, m], '.0f', 'not reached')} | "
+                  f"{fmt(base_medians[w, m], '.0f', 'not reached')} | "
                   f"{statistics.median(r.coverage for r in rs):.1%} | "
                   f"{statistics.median(r.base_coverage for r in rs):.1%} | "
                   f"{statistics.median(r.distance_m for r in rs):.0f} | "
@@ -232,13 +239,23 @@ def print_tables(runs: list[Run], worlds: list[str], methods: list[str]) -> None
     print("| world | cohort / single | cohort / independent | csiro / single | csiro / independent |")
     print("|---|---|---|---|---|")
 
-    def ratio(w: str, a: str, b: str) -> str:
-        ta, tb = medians.get((w, a)), medians.get((w, b))
+    def ratio(w: str, a: str, b: str, of: dict = medians) -> str:
+        ta, tb = of.get((w, a)), of.get((w, b))
         return "-" if ta is None or tb is None else f"{ta / tb:.2f}"
 
     for w in worlds:
         print(f"| {w} | {ratio(w, 'cohort', 'single')} | {ratio(w, 'cohort', 'independent')} | "
               f"{ratio(w, 'csiro', 'single')} | {ratio(w, 'csiro', 'independent')} |")
+    print()
+    print("The same ratios of the median T90 of what the base station knows (a team's map reaches it over the "
+          "radio; lone robots' when they come back within reach):")
+    print()
+    print("| world | cohort / single | cohort / independent | csiro / single | csiro / independent |")
+    print("|---|---|---|---|---|")
+    for w in worlds:
+        print(f"| {w} | {ratio(w, 'cohort', 'single', base_medians)} | "
+              f"{ratio(w, 'cohort', 'independent', base_medians)} | {ratio(w, 'csiro', 'single', base_medians)} | "
+              f"{ratio(w, 'csiro', 'independent', base_medians)} |")
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -21,20 +21,24 @@ from .teams import wall_clock_fields  # noqa: E402
 
 #: Report fields of every run that depend on the wall clock (team strategies add theirs).
 WALL_CLOCK_FIELDS = ("wall_time_s", "real_time_factor")
-#: Coverage fractions whose first sim time the report gives (``coverage_reached_s``):
-#: T80 and T90 of bench/exploration.py.
+#: Coverage fractions whose first sim time the report gives, of the team's coverage
+#: (``coverage_reached_s``: T80 and T90 of bench/exploration.py) and of what the base
+#: station knows (``base_coverage_reached_s``).
 COVERAGE_MILESTONES = (0.8, 0.9)
 
 
-def coverage_reached_s(samples: list, fraction: float) -> float | None:
-    """Sim time at which team coverage (``samples``: the runner's, in time order) first
-    reaches ``fraction``, interpolated linearly between samples; None when it never does."""
+def coverage_reached_s(samples: list, fraction: float, of: str = "team") -> float | None:
+    """Sim time at which a coverage (``of``: the samples' ``team``, or ``base``: what
+    the base station knows; ``samples``: the runner's, in time order) first reaches
+    ``fraction``, interpolated linearly between samples; None when it never does."""
     prev = None
     for s in samples:
-        if s.team >= fraction:
-            if prev is None or s.team == prev.team:
+        value = getattr(s, of)
+        if value >= fraction:
+            if prev is None or value == getattr(prev, of):
                 return round(float(s.t), 3)
-            return round(float(prev.t + (fraction - prev.team) / (s.team - prev.team) * (s.t - prev.t)), 3)
+            before = getattr(prev, of)
+            return round(float(prev.t + (fraction - before) / (value - before) * (s.t - prev.t)), 3)
         prev = s
     return None
 
@@ -77,6 +81,8 @@ def report(mission: Mission, wall_time_s: float) -> dict[str, Any]:
         "base_coverage_fraction": last.base,
         "coverage_reached_s": {f"{f:.0%}": coverage_reached_s(mission.state.samples, f)
                                for f in COVERAGE_MILESTONES},
+        "base_coverage_reached_s": {f"{f:.0%}": coverage_reached_s(mission.state.samples, f, "base")
+                                    for f in COVERAGE_MILESTONES},
         **mission.backend.figures(mission),
         **mission.team.figures(mission),
         **mission.artifacts.figures(mission),

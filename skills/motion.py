@@ -34,14 +34,23 @@ def goal_distance(robot: Robot, goal: np.ndarray) -> float:
     return float(np.linalg.norm(d))
 
 
+#: ``GoTo``'s ``planner`` choices: the planners each tries, in turn (the ``source`` its
+#: ``goto`` event names).
+PLANNERS = {"navigator": ("navigator",), "gbplanner": ("gbplanner2", "navigator"),
+            "navigator_or_gbplanner": ("navigator", "gbplanner2")}
+
+
 class GoTo(PathMotion):
     """Go to a waypoint: the param ``goal`` [x, y, z], or else the blackboard key
     ``goal_key`` (a body-centre position in metres).
 
     The path comes from the navigation graph of the onboard map (``planner:
-    navigator``) or from GBPlanner2's global graph (``planner: gbplanner``, which falls
-    back to the navigation graph when it has no path). A blocked path or an arrival
-    short of the goal is re-planned, at most ``max_replans`` times.
+    navigator``), from GBPlanner2's global graph (``planner: gbplanner``, which falls
+    back to the navigation graph when it has no path), or from the navigation graph
+    with GBPlanner2's global graph as the fallback (``planner: navigator_or_gbplanner``:
+    the known map's shortest way where the graph finds one, else the way the robot
+    came). A blocked path or an arrival short of the goal is re-planned, at most
+    ``max_replans`` times.
 
     Reads ``goal_key`` (when ``goal`` is null). Writes ``goto_failure``: null while
     going and after arrival, else why it failed: ``no_goal`` (none given or not a
@@ -56,8 +65,9 @@ class GoTo(PathMotion):
         "goal": Param(list, None, "waypoint [x, y, z] (m); null: read goal_key", nullable=True, length=3,
                       items=float),
         "goal_key": Param(str, "goal", "blackboard key holding the waypoint [x, y, z]", key=True),
-        "planner": Param(str, "navigator", "navigation graph of the onboard map, or GBPlanner2's global graph",
-                         choices=("navigator", "gbplanner")),
+        "planner": Param(str, "navigator", "navigation graph of the onboard map, GBPlanner2's global graph "
+                         "(then the navigation graph), or the navigation graph then GBPlanner2's",
+                         choices=tuple(PLANNERS)),
         "tolerance_m": Param(float, 1.0, "distance to the goal that counts as arrived", exclusive_minimum=0),
         "max_replans": Param(int, 3, "re-plans after a blocked path or an arrival short of the goal", minimum=0),
     }
@@ -135,22 +145,31 @@ class GoTo(PathMotion):
         return Status.RUNNING
 
     def _path(self, grid: Any) -> tuple[np.ndarray | None, str, str, str]:
-        """(path, source, failure code, reason)."""
-        r, goal = self.robot, self.goal
-        why_gb = ""
-        if self.p["planner"] == "gbplanner":
-            res = gbplanner(self.ctx, r).planner.goto(grid, r.position, goal)
-            if res.ok:
-                return res.path, "gbplanner2", "", ""
-            why_gb = f"global planner: {res.reason}; "
-        nav = navigator(self.ctx, r)
+        """(path, source, failure code, reason): the planners of ``planner`` in turn,
+        the first path found."""
+        code, why = "", ""
+        for source in PLANNERS[self.p["planner"]]:
+            path, code, reason = self._gbplanner_path(grid) if source == "gbplanner2" else self._navigator_path()
+            if path is not None:
+                return path, source, "", ""
+            why += ("; " if why else "") + reason
+        return None, "", code, why
+
+    def _gbplanner_path(self, grid: Any) -> tuple[np.ndarray | None, str, str]:
+        """(path, failure code, reason) on GBPlanner2's global graph."""
+        res = gbplanner(self.ctx, self.robot).planner.goto(grid, self.robot.position, self.goal)
+        return (res.path, "", "") if res.ok else (None, "no_path", f"global planner: {res.reason}")
+
+    def _navigator_path(self) -> tuple[np.ndarray | None, str, str]:
+        """(path, failure code, reason) on the navigation graph of the onboard map."""
+        nav = navigator(self.ctx, self.robot)
         force = self.replans > 0
         if nav.from_robot(force=force) is None:
-            return None, "", "invalid_start", why_gb + "the robot is not on its navigation graph"
-        path, _ = nav.path_to_point(goal, force=force)
+            return None, "invalid_start", "the robot is not on its navigation graph"
+        path, _ = nav.path_to_point(self.goal, force=force)
         if path is None:
-            return None, "", "no_path", why_gb + "no path on the navigation graph of the onboard map"
-        return path, "navigator", "", ""
+            return None, "no_path", "no path on the navigation graph of the onboard map"
+        return path, "", ""
 
     def _fail(self, code: str, reason: str) -> Status:
         self.write("goto_failure", code)
@@ -265,4 +284,4 @@ class Backtrack(PathMotion):
         return status
 
 
-__all__ = ["GOTO_FAILURES", "Backtrack", "GoTo", "goal_distance"]
+__all__ = ["GOTO_FAILURES", "PLANNERS", "Backtrack", "GoTo", "goal_distance"]

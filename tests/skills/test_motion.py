@@ -7,6 +7,7 @@ import pytest
 from delve.planners.gbplanner2 import synthetic as syn
 from delve.planners.occupancy import OCCUPIED
 from delve.skills.motion import Backtrack, GoTo
+from delve.skills.navigation import Navigator
 from delve.skills.robot import PathStatus
 from py_trees.common import Status
 
@@ -97,6 +98,44 @@ def test_goto_with_the_global_planner(tunnel):
     node = GoTo(name="Go", ctx=ctx, goal=goal.tolist(), planner="gbplanner")
     assert run(node, ctx, robot) == Status.SUCCESS
     assert events(ctx, "goto")[0]["source"] == "gbplanner2"
+
+
+@pytest.mark.parametrize("planner, sources", [("navigator", ["navigator"]), ("gbplanner", ["gbplanner2"]),
+                                               ("navigator_or_gbplanner", ["navigator"])])
+def test_goto_takes_the_first_planner_of_its_order_that_finds_a_path(tunnel, planner, sources):
+    grid, a, _ = tunnel
+    robot = FakeRobot(grid, body(a, 3.0))
+    ctx = make_ctx(robot)
+    node = GoTo(name="Go", ctx=ctx, goal=body(a, 6.0, 1.0).tolist(), planner=planner)   # both find one
+    assert run(node, ctx, robot) == Status.SUCCESS
+    assert [e["source"] for e in events(ctx, "goto")] == sources
+
+
+@pytest.mark.parametrize("planner, result", [("navigator", "no_path"), ("navigator_or_gbplanner", "gbplanner2")])
+def test_goto_falls_back_to_the_global_graph_where_the_navigation_graph_finds_none(tunnel, monkeypatch, planner,
+                                                                                   result):
+    grid, a, _ = tunnel
+    robot = FakeRobot(grid, body(a, 3.0))
+    ctx = make_ctx(robot)
+    monkeypatch.setattr(Navigator, "path_to_point", lambda self, point, force=False: (None, float("inf")))
+    node = GoTo(name="Go", ctx=ctx, goal=body(a, 6.0, 1.0).tolist(), planner=planner)
+    status = run(node, ctx, robot)
+    if result == "no_path":
+        assert status == Status.FAILURE and node.get(node.keys["goto_failure"]) == "no_path"
+        assert "navigation graph" in events(ctx, "goto_failed")[0]["reason"]
+    else:
+        assert status == Status.SUCCESS and [e["source"] for e in events(ctx, "goto")] == [result]
+
+
+def test_goto_names_every_planner_it_tried_when_none_finds_a_path(tunnel):
+    grid, a, _ = tunnel
+    robot = FakeRobot(grid, body(a, 3.0))
+    ctx = make_ctx(robot)
+    node = GoTo(name="Go", ctx=ctx, goal=body(a, 10.0, 8.0).tolist(), planner="navigator_or_gbplanner")
+    assert run(node, ctx, robot) == Status.FAILURE
+    reason = events(ctx, "goto_failed")[0]["reason"]
+    assert node.get(node.keys["goto_failure"]) == "no_path"
+    assert reason.index("navigation graph") < reason.index("global planner")
 
 
 def test_goto_replans_after_a_blocked_path_and_gives_up(tunnel):
