@@ -20,9 +20,10 @@ def run_bench_sweep(out: Path, scenario: dict, sweep: dict, jobs: int, scheduler
     (out / "sweep.yaml").write_text(yaml.safe_dump(sweep, sort_keys=False))
     t0 = time.perf_counter()
 
-    def done(n: int, total: int, spec, record: dict) -> None:
-        print(f"  [{n}/{total}] {spec.run_id} {record['status']} ({time.perf_counter() - t0:.0f} s)",
-              file=sys.stderr, flush=True)
+    def done(n: int, total: int, spec, record: dict | None) -> None:
+        line = f"  {total} runs to run" if spec is None else \
+            f"  [{n}/{total}] {spec.run_id} {record['status']} ({time.perf_counter() - t0:.0f} s)"
+        print(line, file=sys.stderr, flush=True)
 
     return run_sweep(load_sweep(out / "sweep.yaml"), out / "results", workers=None if scheduler else jobs,
                      scheduler=scheduler, progress=done)

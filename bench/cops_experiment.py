@@ -59,7 +59,7 @@ def reports(team_sizes: list[int], seed: int, duration_s: float, out: Path, work
     out.mkdir(parents=True, exist_ok=True)
     (out / "sweep.yaml").write_text(yaml.safe_dump(sweep_doc(team_sizes, seed, duration_s), sort_keys=False))
     result = run_sweep(load_sweep(out / "sweep.yaml"), out / "results", workers=None if scheduler else workers,
-                       scheduler=scheduler, plots=False, progress=lambda done, total, spec, record: print(
+                       scheduler=scheduler, plots=False, progress=lambda done, total, spec, record: spec and print(
                            f"  [{done}/{total}] {spec.run_id} {record['status']}", file=sys.stderr, flush=True))
     rows = []
     for n, row in zip(team_sizes, result.table.itertuples()):

@@ -27,6 +27,9 @@ from .sweep_table import plot_figures, results_table, write_table
 CONNECT_TIMEOUT_S = 10
 #: Exit status of a sweep stopped by Ctrl-C (128 + SIGINT, as a shell reports it).
 INTERRUPTED = 130
+#: ``progress(done, total, spec, record)``: before the first run (0, total, None, None),
+#: then once per finished run.
+Progress = Callable[[int, int, "RunSpec | None", "dict | None"], None]
 
 
 @dataclass
@@ -79,11 +82,11 @@ def _quiet_on_interrupt() -> Iterator[None]:
 
 
 def run_sweep(sweep: Sweep, out: Path, *, workers: int | None = None, scheduler: str | None = None,
-              retry_failed: bool = False, progress: Callable[[int, int, RunSpec, dict], None] | None = None,
-              plots: bool = True) -> SweepResult:
+              retry_failed: bool = False, progress: Progress | None = None, plots: bool = True) -> SweepResult:
     """Run every run of ``sweep`` not yet finished in ``out`` (failed ones too with
     ``retry_failed``), then write the table and (with ``plots``) the plots.
-    ``progress(done, total, spec, record)`` is called as each run finishes."""
+    ``progress(done, total, spec, record)`` is called once before the first run (0,
+    total, None, None) and then as each run finishes."""
     check_out_dir(out)
     out = out.resolve()
     runs_dir = out / "runs"
@@ -94,6 +97,8 @@ def run_sweep(sweep: Sweep, out: Path, *, workers: int | None = None, scheduler:
             records[spec.run_id] = record
     skipped = len(records)
     todo = [spec for spec in sweep.runs if spec.run_id not in records]
+    if progress is not None:
+        progress(0, len(todo), None, None)
     if todo:
         from dask.distributed import as_completed
 
@@ -118,7 +123,7 @@ def run_sweep(sweep: Sweep, out: Path, *, workers: int | None = None, scheduler:
 
 
 @contextmanager
-def progress_bar(name: str) -> Iterator[Callable[[int, int, RunSpec, dict], None]]:
+def progress_bar(name: str) -> Iterator[Progress]:
     """A progress bar on stderr that counts finished runs (of those to run now), with
     a line per run."""
     from rich.console import Console
@@ -130,8 +135,11 @@ def progress_bar(name: str) -> Iterator[Callable[[int, int, RunSpec, dict], None
         task = bar.add_task(f"sweep {name}", total=None, failed="")
         failures = 0
 
-        def update(done: int, total: int, spec: RunSpec, record: dict) -> None:
+        def update(done: int, total: int, spec: RunSpec | None, record: dict | None) -> None:
             nonlocal failures
+            if spec is None or record is None:   # before the first run: the total is known
+                bar.update(task, total=total)
+                return
             failures += record["status"] != "ok"
             wall = record.get("wall_time_s")
             took = f" ({wall:.1f} s)" if isinstance(wall, (int, float)) else ""

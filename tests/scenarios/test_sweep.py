@@ -27,18 +27,25 @@ GRID = "scenarios: [tiny.yaml]\nseeds: [1, 2]\ngrid:\n  radio.range_m: [40, 60]\
 
 @pytest.fixture(scope="module")
 def swept(tmp_path_factory):
-    """The sweep run once: its folder, the sweep and what run_sweep returned."""
+    """The sweep run once: its folder, the sweep, what run_sweep returned and its
+    progress calls (done, total, run id)."""
     folder = tmp_path_factory.mktemp("sweep")
     text = (DATA / "small_tunnel.yaml").read_text().replace("../../../trees", str(TREES_DIR))
     (folder / "tiny.yaml").write_text(text.replace("duration_s: 600", f"duration_s: {TINY_DURATION_S}"))
     (folder / "s.yaml").write_text(GRID)
     sweep = load_sweep(folder / "s.yaml")
-    return folder, sweep, run_sweep(sweep, folder / "out", workers=2)
+    calls = []
+    result = run_sweep(sweep, folder / "out", workers=2,
+                       progress=lambda done, total, spec, _: calls.append((done, total, spec and spec.run_id)))
+    return folder, sweep, result, calls
 
 
 def test_the_table_has_a_row_per_run_and_a_plot_per_figure(swept):
-    folder, sweep, result = swept
+    folder, sweep, result, calls = swept
     assert (result.ran, result.skipped, result.failed) == (4, 0, 0)
+    # The progress bar learns the total before the first run, then counts each one.
+    assert calls[0] == (0, 4, None) and [c[:2] for c in calls[1:]] == [(i, 4) for i in (1, 2, 3, 4)]
+    assert sorted(c[2] for c in calls[1:]) == sorted(r.run_id for r in sweep.runs)
     table = pd.read_parquet(folder / "out" / "results.parquet")
     assert table["run_id"].tolist() == [r.run_id for r in sweep.runs]
     assert table["status"].tolist() == ["ok"] * 4 and table["seed"].tolist() == [1, 2, 1, 2]
@@ -54,7 +61,7 @@ def test_the_table_has_a_row_per_run_and_a_plot_per_figure(swept):
 def test_the_same_run_gives_the_same_report_as_delve_run(swept):
     """Each run, though a worker ran another before it, equals ``delve run`` of the
     same scenario and seed in a fresh process (the file's range is 40 m)."""
-    folder, sweep, _ = swept
+    folder, sweep, _, _ = swept
     for run in sweep.runs[:2]:
         out = folder / f"alone-{run.seed}"
         subprocess.run([sys.executable, "-m", "delve.executive.cli", "run", str(folder / "tiny.yaml"), "--seed",
@@ -67,7 +74,7 @@ def test_the_same_run_gives_the_same_report_as_delve_run(swept):
 
 
 def test_a_second_start_runs_only_what_is_unfinished_and_a_failure_stops_nothing(swept, capsys):
-    folder, sweep, _ = swept
+    folder, sweep, _, _ = swept
     runs = folder / "out" / "runs"
     (runs / sweep.runs[1].run_id / MARKER).unlink()  # as if the sweep stopped while it ran
     kept = {r.run_id: (runs / r.run_id / "report.json").stat().st_mtime_ns for r in sweep.runs}
