@@ -82,12 +82,11 @@ class ReturnToLinkPoint(GoTo):
     robot is (the paper names the point, not what the robot does when the link comes
     back sooner).
 
-    The way back follows the onboard map's navigation graph, the known map's shortest
-    way, and GBPlanner2's global graph (the way the robot came) where that graph finds
-    none (``planner: navigator_or_gbplanner``): the navigation graph keeps more room
-    around an aerial robot than GBPlanner2's box and finds no way through squeezes the
-    robot flew through. The way flown is added to GBPlanner2's global graph as
-    ``FollowHubPath`` adds its own. Reads ``cohort_link_points``; writes
+    The way back follows GBPlanner2's global graph (``planner: gbplanner``): the
+    navigation graph of the onboard map keeps more room around an aerial robot than
+    GBPlanner2's box and found no way through squeezes the robot had flown through
+    (the robot then gave up exploring). The way flown is added to GBPlanner2's global
+    graph as ``FollowHubPath`` adds its own. Reads ``cohort_link_points``; writes
     ``goto_failure`` as ``GoTo``. Logs ``cohort_backtrack`` when it sets out,
     ``cohort_link_point`` at each point reached (linked or not) and
     ``cohort_link_regained`` where a ping on the way was answered. Returns RUNNING on
@@ -95,7 +94,7 @@ class ReturnToLinkPoint(GoTo):
     """
 
     PARAMS = {**{k: v for k, v in GoTo.PARAMS.items() if k not in ("goal", "goal_key")},
-              "planner": replace(GoTo.PARAMS["planner"], default="navigator_or_gbplanner"),
+              "planner": replace(GoTo.PARAMS["planner"], default="gbplanner"),
               "ping_attempts": Param(int, 3, "pings tried at a point before it counts as without link", minimum=1),
               "ping_every_s": Param(float, 2.0, "on the way, one ping this often; an answer ends the way back",
                                     exclusive_minimum=0),

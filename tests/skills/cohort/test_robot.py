@@ -13,7 +13,6 @@ from delve.skills.cohort.lost_link import CohortTimer, ExplorationOver, ReturnTo
 from delve.skills.cohort.hub import ASSIGNMENT, REQUEST, SUBMAP
 from delve.skills.cohort.robot import CallHub, FollowHubPath, SendSubmaps
 from delve.skills.gbplanner import SERVICE as GBPLANNER, gbplanner
-from delve.skills.navigation import Navigator
 from delve.skills.robot import PathStatus
 from py_trees.common import Status
 
@@ -300,17 +299,16 @@ def test_return_ends_where_a_ping_on_the_way_is_answered(tunnel):
     assert not events(ctx, "cohort_link_point") and robot.path_status != PathStatus.FOLLOWING
 
 
-def test_return_follows_the_navigation_graph_and_gbplanner2s_global_graph_where_it_has_none(tunnel, monkeypatch):
-    robot, ctx, node = returning(tunnel, 9.0, [5.0], ping_every_s=1000.0)
-    robot.radio.link_up = True
-    assert run(node, ctx, robot) == Status.SUCCESS
-    assert [e["source"] for e in events(ctx, "goto")] == ["navigator"]
-    # A squeeze the navigation graph's room around the robot does not pass; the way flown does.
-    monkeypatch.setattr(Navigator, "path_to_point", lambda self, point, force=False: (None, float("inf")))
+def test_return_follows_gbplanner2s_global_graph_and_the_navigation_graph_where_it_has_none(tunnel):
+    _, a, _ = tunnel
     robot, ctx, node = returning(tunnel, 9.0, [5.0], ping_every_s=1000.0)   # a direct edge of the global graph
     robot.radio.link_up = True
     assert run(node, ctx, robot) == Status.SUCCESS
     assert [e["source"] for e in events(ctx, "goto")] == ["gbplanner2"]
+    robot, ctx, node = returning(tunnel, 30.0, [5.0], ping_every_s=1000.0)   # beyond the global graph's reach
+    robot.radio.link_up = True
+    assert run(node, ctx, robot) == Status.SUCCESS
+    assert [e["source"] for e in events(ctx, "goto")] == ["navigator"]
 
 
 def test_return_ends_at_home_and_fails_when_no_point_links(tunnel):
