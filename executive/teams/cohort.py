@@ -94,17 +94,21 @@ class Cohort(TeamStrategy):
 
     @classmethod
     def check_world(cls, scenario: "Scenario", world: Any) -> None:
-        """A ``box_m`` given in the scenario that is larger than the world along every
-        axis restricts nothing: a mistake (the paper's default is not checked)."""
+        """A ``box_m`` given in the scenario that is at least twice the world's size
+        along every axis covers the whole world wherever the hub centres it (on a
+        frontier inside the world), so it restricts nothing: a mistake (the paper's
+        default is not checked). A smaller box, even one larger than the world, keeps a
+        robot near a frontier off-centre."""
         team = scenario.doc.get("team")
         if team is None or "box_m" not in team or not hasattr(world, "bounds_max"):
             return
         extent = np.asarray(world.bounds_max, float) - np.asarray(world.bounds_min, float)
         box = np.asarray(team["box_m"], float)
-        if np.all(box > extent):
+        if np.all(box >= 2.0 * extent):
             raise DelveError(f"team: box_m {' x '.join(f'{v:g}' for v in box)} m is larger than the world "
-                             f"({' x '.join(f'{v:.0f}' for v in extent)} m): the box would restrict nothing; "
-                             "give a smaller box_m or leave it out", scenario.path, team.key_line("box_m"))
+                             f"({' x '.join(f'{v:.0f}' for v in extent)} m), at least twice its size along every "
+                             "axis: centred anywhere in it the box would restrict nothing; give a smaller box_m "
+                             "or leave it out", scenario.path, team.key_line("box_m"))
 
     def robot_services(self, name: str) -> dict[str, Any]:
         return {PARAMS_SERVICE: self.cohort}

@@ -66,8 +66,14 @@ def test_a_box_given_larger_than_the_world_is_refused_at_its_line(tmp_path):
     assert err.value.line == 4
 
 
-def test_a_box_larger_along_some_axes_only_and_the_default_box_pass(tmp_path):
-    for team in ("{strategy: cohort, box_m: [500, 500, 4]}", "{strategy: cohort}"):
+def test_a_box_that_restricts_somewhere_and_the_default_box_pass(tmp_path):
+    world = scenario(tmp_path, "{strategy: cohort}").build_world()
+    extent = world.bounds_max - world.bounds_min
+    # Larger than the world along every axis, but under twice its height: centred on a
+    # frontier near the floor or the roof, it keeps the robot off the other end.
+    tall = [500, 500, round(1.5 * float(extent[2]), 1)]
+    for team in ("{strategy: cohort, box_m: [500, 500, 4]}", f"{{strategy: cohort, box_m: {tall}}}",
+                 "{strategy: cohort}"):
         s = scenario(tmp_path, team)
         s.check_starts(s.build_world())
 
