@@ -139,8 +139,9 @@ class CohortHub:
         lost its way back) as held by it, and the other robots holding none that the
         hub heard from (a submap made or a call) in that time as free, but for those
         it answered without a frontier less than T_C before (:meth:`told_none`).
-        Recomputes the frontiers first when a submap arrived since. The answer is
-        recorded."""
+        Recomputes the frontiers first when a submap arrived since. When the common
+        map has no frontier point left at all (:attr:`explored`) the answer is reason
+        ``explored``. The answer is recorded."""
         if self.stale:
             self.update_frontiers()
         self.robot_positions[robot] = np.asarray(position, float).copy()
@@ -157,14 +158,25 @@ class CohortHub:
                 if n not in (robot, HOME) and n not in busy and t_s - heard <= hold
                 and not self.told_none(n, t_s)]
         lo, hi = self.common.bounds
-        result = choose_frontier(self.graph, self.clusters, self.links, entries, robot,
-                                 best_share_pct=self.params.best_share_pct, box_m=self.params.box_m,
-                                 world_min=lo, world_max=hi, holders=holders, free=free)
+        if self.explored:
+            result = Reposition(None, reason="explored")
+        else:
+            result = choose_frontier(self.graph, self.clusters, self.links, entries, robot,
+                                     best_share_pct=self.params.best_share_pct, box_m=self.params.box_m,
+                                     world_min=lo, world_max=hi, holders=holders, free=free)
         points = self.clusters[result.cluster].voxels if result.ok else np.zeros(0, dtype=np.int64)
         record = AssignmentRecord(robot, float(t_s), int(request_id), result, points)
         self.assignments.append(record)
         self.last_assignment[robot] = record
         return result
+
+    @property
+    def explored(self) -> bool:
+        """Whether the common map is closed: submaps came, and not one frontier point
+        (of any cluster size) is left in it. Whatever a robot still out of reach finds
+        joins the map through ground the team's submaps showed open, so a closed
+        common map is the team's whole world. (Frontiers under f_min keep it open.)"""
+        return bool(self.submaps) and not len(self.frontiers.all_points())
 
     def told_none(self, robot: str, t_s: float) -> bool:
         """Whether ``robot``'s latest answer, given less than T_C before ``t_s``, had no

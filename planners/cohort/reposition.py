@@ -50,7 +50,8 @@ class Reposition:
     none), its centroid ``frontier``, the ``path`` along G_C (from the calling robot's
     entry vertex to the cluster's linked vertex), the box, the cluster's size, the
     path ``distance_m`` and ``reason`` ("ok", "no_frontier", "no_graph",
-    "unreachable", "taken"). ``distances_m``: from each source (robot names, "home") to the
+    "unreachable", "taken"; the hub answers "explored" itself, see
+    :attr:`CohortHub.explored`). ``distances_m``: from each source (robot names, "home") to the
     chosen cluster."""
 
     cluster: int | None

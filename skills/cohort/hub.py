@@ -123,7 +123,8 @@ class AnswerRepositionRequests(HubSkill):
     frontier cluster among the best n_C % (the closest when no other robot competes:
     :func:`~delve.planners.cohort.choose_frontier`), the path to it along G_C and the
     box D around it, or ``frontier`` None and a ``reason`` ("no_frontier", "no_graph",
-    "unreachable", "taken") when there is none. The frontiers are recomputed first if a submap
+    "unreachable", "taken"; "explored" when the common map has no frontier point left)
+    when there is none. The frontiers are recomputed first if a submap
     arrived since.
 
     Reads services ``radio``, ``map``, ``cohort_hub``. Logs ``cohort_assignment`` per

@@ -54,10 +54,11 @@ class CohortTimer(Skill):
 class ExplorationOver(Skill):
     """Whether this robot's exploration is over: GBPlanner2 decided that homing is due,
     or it found nothing left to explore with no box around it (a box explored is not
-    the end: the hub gives the next one).
+    the end: the hub gives the next one), or the hub answered that its common map has
+    no frontier left (the team explored its world).
 
-    Reads ``homing_due``, ``exploration_complete`` and ``exploration_bbox``. Returns
-    SUCCESS when over, else FAILURE.
+    Reads ``homing_due``, ``exploration_complete``, ``exploration_bbox`` and
+    ``cohort_explored``. Returns SUCCESS when over, else FAILURE.
     """
 
     AGENT = None
@@ -65,10 +66,13 @@ class ExplorationOver(Skill):
         "homing_due": PortInformation(bool, required=False, description="GBPlanner2 calls for homing"),
         "exploration_complete": PortInformation(bool, required=False, description="GBPlanner2 found nothing left"),
         "exploration_bbox": PortInformation(dict | None, required=False, description="the box explored; null: none"),
+        "cohort_explored": PortInformation(bool, required=False, description="the hub's common map has no frontier "
+                                           "left"),
     }
 
     def update(self) -> Status:
-        if self.read("homing_due") or (self.read("exploration_complete") and self.read("exploration_bbox") is None):
+        if self.read("homing_due") or self.read("cohort_explored") or (
+                self.read("exploration_complete") and self.read("exploration_bbox") is None):
             return Status.SUCCESS
         return Status.FAILURE
 

@@ -125,7 +125,8 @@ class CallHub(Skill):
     ``cohort_path`` (the path along the hub's global graph G_C) and
     ``exploration_bbox`` (the box D around the frontier); without one (the hub has
     nothing to give) those are null and the box is lifted, so that GBPlanner2 explores
-    on its own. A frontier within ``repeat_radius_m`` of the last target, when the
+    on its own. ``cohort_explored`` says whether the hub answered that its common map
+    has no frontier left (reason ``explored``): the team's exploration is over. A frontier within ``repeat_radius_m`` of the last target, when the
     robot found that box explored (``exploration_complete``), counts as none (reason
     ``repeated``): the hub's frontier is one the robot's sensors cannot clear. A call
     that fails sets ``cohort_goal`` to null (nothing to follow) and keeps the box.
@@ -159,6 +160,8 @@ class CallHub(Skill):
         "cohort_path": PortInformation(list | None, description="[[x, y, z], ...] the hub's path along G_C"),
         "exploration_bbox": PortInformation(dict | None, description="{min, max}: the box D around the frontier; "
                                             "null: no box"),
+        "cohort_explored": PortInformation(bool, description="the hub's last answer: its common map has no "
+                                           "frontier left"),
     }
 
     def __init__(self, name: str, ctx: Any, remap: dict[str, str] | None = None, **params: Any):
@@ -230,6 +233,7 @@ class CallHub(Skill):
         self.write("cohort_goal", goal)
         self.write("cohort_path", path)
         self.write("exploration_bbox", box)
+        self.write("cohort_explored", answer.get("reason") == "explored")
         self.feedback_message = f"assigned {answer.get('reason', '')}".strip()
         self.event("cohort_assignment_received", request_id=self.request_id,
                    frontier=None if frontier is None else xyz(frontier, 2), box=box,

@@ -83,3 +83,16 @@ def test_same_seed_same_report_and_log(tmp_path):
     assert json.dumps(strip_wall_clock(a)) == json.dumps(strip_wall_clock(b))
     assert a["cohort"]["submaps_at_hub"] > 0 and len(a["cohort"]["assignments"]) >= 2
     assert (tmp_path / "a" / "log.jsonl").read_bytes() == (tmp_path / "b" / "log.jsonl").read_bytes()
+
+
+def test_once_the_hub_knows_no_frontier_left_the_robots_go_home():
+    """The fork's network is small: the common map closes, every robot's next call is
+    answered ``explored``, and each goes home at once (no more T_C cycles)."""
+    mission, report = run_scenario(DATA / "cohort_fork.yaml", duration_s=600)
+    for r in ("a", "b"):
+        answers = [e for e in robot_events(mission, r) if e["event"] == "cohort_assignment_received"]
+        assert answers[-1]["reason"] == "explored" and all(a["reason"] != "explored" for a in answers[:-1])
+        homing = next(e for e in mission.state.events if e.get("agent") == r and e["event"] == "homing")
+        assert homing["t"] - answers[-1]["t"] < 1.0
+    assert mission.outcome.succeeded and mission.finished_s < 300
+    assert mission.state.samples[-1].team > 0.95

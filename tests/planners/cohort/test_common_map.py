@@ -37,3 +37,24 @@ def test_incremental_merges_equal_pooling_the_whole_fine_map():
     expected = padded.reshape(nx, 2, ny, 2, nz, 2).max(axis=(1, 3, 5))
     assert np.array_equal(m.occupancy, expected)
     assert (m.occupancy == FREE).any() and (m.occupancy == OCCUPIED).any()
+
+
+def test_submaps_merged_in_any_order_give_the_same_map():
+    """Submaps queued while the link was down arrive late and out of order: a newer
+    submap's rock (seen where an older one saw free space) stays rock either way."""
+    import itertools
+
+    truth = fork()
+    submaps = [align_submap(*cut(truth, lo, hi)) for lo, hi in [(0, 20), (15, 40), (35, 60)]]
+    older_flat, older_values = submaps[1]
+    seen_free = older_values.copy()
+    seen_free[older_values == OCCUPIED] = FREE   # the older look: rock not yet told apart from free
+    submaps.insert(1, (older_flat, seen_free))
+    maps = []
+    for order in itertools.permutations(range(len(submaps))):
+        m = CommonMap(truth.shape, truth.origin, truth.voxel_size_m, 0.4)
+        for i in order:
+            m.merge(*submaps[i])
+        maps.append(m.occupancy)
+    assert all(np.array_equal(maps[0], other) for other in maps[1:])
+    assert (maps[0] == OCCUPIED).any()

@@ -62,6 +62,18 @@ def test_no_frontier_before_any_submap():
     assert r.reason == "no_frontier" and r.frontier is None
 
 
+def test_a_closed_common_map_is_explored_and_one_with_small_frontiers_is_not():
+    whole = ("a", 0, 0, 60, [[3, 20, Z], [30, 20, Z], [38, 30, Z], [38, 10, Z]])   # every dead end seen
+    hub, fine = hub_after(whole)
+    r = hub.reposition(fine, "a", np.array([30, 20, Z]), 10.0)
+    assert hub.explored and r.reason == "explored" and r.frontier is None
+    big = CohortParams(f_min=10_000)   # the trunk's end face stays open, under f_min
+    hub, fine = hub_after(TRUNK)
+    hub.params = big
+    r = hub.reposition(fine, "a", np.array([18, 20, Z]), 10.0)
+    assert not hub.explored and r.reason == "no_frontier"
+
+
 def test_the_same_submaps_give_the_same_answers():
     answers = []
     for _ in range(2):

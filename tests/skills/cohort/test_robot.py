@@ -160,6 +160,18 @@ def test_no_frontier_lifts_the_box(robot):
     assert bb("cohort_goal") is None and bb("cohort_path") is None and bb("exploration_bbox") is None
 
 
+@pytest.mark.parametrize("reason", ["explored", "no_frontier"])
+def test_the_hubs_word_that_all_is_explored_is_written(robot, reason):
+    ctx = ctx_for(robot)
+    node = CallHub(name="Call", ctx=ctx)
+    node.tick_once()
+    robot.radio.deliver("base", ASSIGNMENT, {"request_id": 1, "frontier": None, "path": None, "box_min": None,
+                                             "box_max": None, "cluster_size": 0, "reason": reason})
+    node.tick_once()
+    assert node.status == Status.SUCCESS and bb("cohort_goal") is None
+    assert bb("cohort_explored") is (reason == "explored")
+
+
 def test_no_answer_in_time_fails_and_the_next_call_asks_again(robot):
     ctx = ctx_for(robot)
     node = CallHub(name="Call", ctx=ctx, answer_timeout_s=5.0)
@@ -244,15 +256,17 @@ def test_cohort_timer_waits_the_span_of_the_teams_params(robot, span, seconds):
     assert bool(events(ctx, "cohort_extra_exploration")) == (span == "extra_explore_s")
 
 
-@pytest.mark.parametrize("homing, complete, box, over", [
-    (True, False, {"min": [0, 0, 0], "max": [1, 1, 1]}, True),
-    (False, True, None, True),
-    (False, True, {"min": [0, 0, 0], "max": [1, 1, 1]}, False),  # a box explored: ask the hub
-    (False, False, None, False),
+@pytest.mark.parametrize("homing, complete, box, explored, over", [
+    (True, False, {"min": [0, 0, 0], "max": [1, 1, 1]}, False, True),
+    (False, True, None, False, True),
+    (False, True, {"min": [0, 0, 0], "max": [1, 1, 1]}, False, False),  # a box explored: ask the hub
+    (False, False, None, False, False),
+    (False, False, {"min": [0, 0, 0], "max": [1, 1, 1]}, True, True),  # the hub: nothing left
 ])
-def test_exploration_over(robot, homing, complete, box, over):
+def test_exploration_over(robot, homing, complete, box, explored, over):
     ctx = ctx_for(robot)
-    for key, value in (("homing_due", homing), ("exploration_complete", complete), ("exploration_bbox", box)):
+    for key, value in (("homing_due", homing), ("exploration_complete", complete), ("exploration_bbox", box),
+                       ("cohort_explored", explored)):
         py_trees.blackboard.Blackboard.set(f"/r1/{key}", value)
     node = ExplorationOver(name="Over?", ctx=ctx)
     node.tick_once()
