@@ -137,8 +137,9 @@ class Cohort(TeamStrategy):
         return {"cohort": cohort_figures(mission.state.events, list(mission.robots), self.hub(mission))}
 
     def draw(self, ax: Any, mission: "Mission", band: HeightBand = ALL_HEIGHTS) -> None:
-        """On ``map.png``: the hub's frontier clusters at the end, every box it gave
-        and the points where robots spoke to the hub (those at ``band``'s heights)."""
+        """On ``map.png``: the hub's frontier clusters at the end, every box it gave,
+        each frontier it gave (with the robot and the time), and the points where
+        robots called the hub, with a link and without (those at ``band``'s heights)."""
         hub = self.hub(mission)
         if hub is not None:
             world = mission.world
@@ -156,15 +157,20 @@ class Cohort(TeamStrategy):
                             label=None if boxes else "COHORT box")
                     boxes += 1
                 ax.plot(*rec.result.frontier[:2], "*", ms=8, color="purple",
-                        label=None if targets else "COHORT target")
+                        label=None if targets else "COHORT target (robot, time given)")
+                ax.annotate(f"{rec.robot} {rec.t_s:.0f} s", rec.result.frontier[:2], xytext=(4, 4 + 7 * (targets % 2)),
+                            textcoords="offset points", fontsize=6.5, color="purple",
+                            bbox={"fc": "white", "ec": "none", "alpha": 0.75, "pad": 0.5})
                 targets += 1
             c = band.within(hub.frontier_centroids)
             if len(c):
                 ax.plot(c[:, 0], c[:, 1], "D", ms=4, mfc="none", color="darkorange", label="hub frontiers (end)")
-        calls = band.within(np.array([e["position"] for e in mission.state.events if e["event"] == "cohort_call"
-                                      and e.get("reached")]))
-        if len(calls):
-            ax.plot(calls[:, 0], calls[:, 1], "x", ms=5, color="black", label="call to the hub (link)")
+        for reached, colour, label in ((True, "black", "call to the hub (link)"),
+                                       (False, "red", "call, hub out of reach")):
+            calls = band.within(np.array([e["position"] for e in mission.state.events
+                                          if e["event"] == "cohort_call" and bool(e.get("reached")) == reached]))
+            if len(calls):   # above the radio-link dots
+                ax.plot(calls[:, 0], calls[:, 1], "x", ms=5, mew=1.2, color=colour, label=label, zorder=6)
 
 
 def cohort_figures(events: list[dict[str, Any]], robots: list[str], hub: Any) -> dict[str, Any]:

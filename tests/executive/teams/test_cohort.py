@@ -120,28 +120,31 @@ def test_the_report_counts_per_robot_and_lists_the_assignments():
 
 def drawn_labels(world, band: HeightBand = ALL_HEIGHTS) -> set[str]:
     mission = SimpleNamespace(agents={"base": SimpleNamespace(ctx=SimpleNamespace(services={"cohort_hub": fake_hub()}))},
-                              state=SimpleNamespace(events=[{"event": "cohort_call", "reached": True,
-                                                             "position": [1.0, 0.0, 1.0]}]), world=world)
+                              state=SimpleNamespace(events=[
+                                  {"event": "cohort_call", "reached": True, "position": [1.0, 0.0, 1.0]},
+                                  {"event": "cohort_call", "reached": False, "position": [70.0, 0.0, 1.0]}]),
+                              world=world)
     fig, ax = plt.subplots()
     Cohort().draw(ax, mission, band)
-    labels = {line.get_label() for line in ax.get_lines()}
+    labels = {line.get_label() for line in ax.get_lines()} | {t.get_text() for t in ax.texts}
     plt.close(fig)
     return labels
 
 
 def test_the_map_shows_boxes_targets_frontiers_and_calls():
     world = SimpleNamespace(bounds_min=(-50.0, -50.0, -5.0), bounds_max=(50.0, 50.0, 10.0))
-    assert {"COHORT box", "COHORT target", "hub frontiers (end)", "call to the hub (link)"} <= drawn_labels(world)
+    assert {"COHORT box", "COHORT target (robot, time given)", "r1 50 s", "hub frontiers (end)",
+            "call to the hub (link)", "call, hub out of reach"} <= drawn_labels(world)
 
 
 def test_a_box_spanning_the_world_across_is_not_drawn():
     world = SimpleNamespace(bounds_min=(0.0, -5.0, 0.0), bounds_max=(20.0, 9.0, 10.0))
     labels = drawn_labels(world)
-    assert "COHORT box" not in labels and "COHORT target" in labels
+    assert "COHORT box" not in labels and "COHORT target (robot, time given)" in labels
 
 
 def test_a_view_of_one_level_draws_only_what_lies_at_its_heights():
     world = SimpleNamespace(bounds_min=(-50.0, -50.0, -5.0), bounds_max=(50.0, 50.0, 10.0))
-    assert {"COHORT target", "call to the hub (link)"} <= drawn_labels(world, HeightBand(hi_m=5.0))
+    assert {"COHORT target (robot, time given)", "call to the hub (link)"} <= drawn_labels(world, HeightBand(hi_m=5.0))
     above = drawn_labels(world, HeightBand(lo_m=5.0))                   # the target and the call are at 1 m
-    assert "COHORT target" not in above and "call to the hub (link)" not in above
+    assert "COHORT target (robot, time given)" not in above and "call to the hub (link)" not in above
