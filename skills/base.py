@@ -95,6 +95,15 @@ KEY_PATTERN = re.compile(r"/?[A-Za-z0-9_]+(?:[/.][A-Za-z0-9_]+)*")
 KEY_RULE = "names of letters, digits and _ joined by '/', or '.' for an attribute"
 
 
+def _type_name(value: Any) -> str:
+    """The plain type name of a YAML value: a list or mapping read with its lines
+    (the loader's subclasses) is a ``list`` or ``dict``."""
+    for plain in (bool, int, float, str, list, dict):
+        if isinstance(value, plain):
+            return plain.__name__
+    return type(value).__name__
+
+
 # delve keeps its own Param for a node's YAML parameters: py_trees' PortInformation
 # (type, required, description, default) has no bounds, choices, null-ability or key
 # marking, and the tree loader needs those to check a YAML node (with its file and
@@ -132,7 +141,7 @@ class Param:
         """Return why ``value`` is not acceptable, or None when it is."""
         if value is None:
             return None if self.nullable else "must not be null"
-        shown = f"{type(value).__name__} {short_repr(value)}"
+        shown = f"{_type_name(value)} {short_repr(value)}"
         if self.type is float:
             if isinstance(value, bool) or not isinstance(value, (int, float)):
                 return f"must be a number, not {shown}{yaml_number_hint(value)}"
@@ -169,7 +178,7 @@ class Param:
         if self.items is float:
             for i, item in enumerate(value):
                 if isinstance(item, bool) or not isinstance(item, (int, float)):
-                    return (f"item {i} must be a number, not {type(item).__name__} {short_repr(item)}"
+                    return (f"item {i} must be a number, not {_type_name(item)} {short_repr(item)}"
                             f"{yaml_number_hint(item)}")
                 if isinstance(item, int) and not _fits_float(item):
                     return f"item {i} must be a number within +-1.8e308, not {short_repr(item)}"
