@@ -275,7 +275,8 @@ def _team(doc: YamlDict, path: Path, tree_types: set[type]) -> TeamSpec:
             return TeamSpec(TEAM_STRATEGIES[DEFAULT_STRATEGY], {})
         warnings.warn(DelveDeprecation(
             f"{path}: no 'team:' key; the trees use behaviours of strategy {name!r}. "
-            f"Add 'team: {{strategy: {name}}}' (a scenario without it will be an independent team)"), stacklevel=2)
+            f"It runs as a {name!r} team with the default parameters; add 'team: {{strategy: {name}}}' (a later "
+            "version will run a scenario without 'team:' as an independent team)"), stacklevel=2)
         return TeamSpec(TEAM_STRATEGIES[name], {})
     name = team["strategy"]
     if name not in TEAM_STRATEGIES:

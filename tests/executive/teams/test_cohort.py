@@ -148,3 +148,15 @@ def test_a_view_of_one_level_draws_only_what_lies_at_its_heights():
     assert {"COHORT target (robot, time given)", "call to the hub (link)"} <= drawn_labels(world, HeightBand(hi_m=5.0))
     above = drawn_labels(world, HeightBand(lo_m=5.0))                   # the target and the call are at 1 m
     assert "COHORT target (robot, time given)" not in above and "call to the hub (link)" not in above
+
+
+def test_without_a_team_key_the_trees_imply_cohort_and_the_warning_says_so(tmp_path):
+    from delve.executive.errors import DelveDeprecation
+
+    path = tmp_path / "s.yaml"
+    path.write_text(f"name: s\nworld: {{generator: tunnel_network, total_length_m: 60, loops: 0}}\n"
+                    f"base_station: {{tree: {TREES / 'cohort_hub.yaml'}}}\nrobots:\n"
+                    f"  - {{name: r1, platform: aerial, tree: {TREES / 'cohort_robot.yaml'}}}\n")
+    with pytest.warns(DelveDeprecation, match="runs as a 'cohort' team with the default parameters"):
+        s = load_scenario(path)
+    assert s.team.strategy is Cohort
