@@ -52,6 +52,12 @@ def sweep_doc(team_sizes: list[int], seed: int, duration_s: float) -> dict:
                      for n in team_sizes]}
 
 
+def _progress(done: int, total: int, spec, record: dict | None) -> None:
+    """A line per finished run (none before the first: the sweep's first call gives the total)."""
+    if spec is not None and record is not None:
+        print(f"  [{done}/{total}] {spec.run_id} {record['status']}", file=sys.stderr, flush=True)
+
+
 def reports(team_sizes: list[int], seed: int, duration_s: float, out: Path, workers: int,
             scheduler: str | None) -> list[tuple[int, dict | None, float, str]]:
     """Run the sweep into ``out``: per team size its report (None when the run
@@ -59,8 +65,7 @@ def reports(team_sizes: list[int], seed: int, duration_s: float, out: Path, work
     out.mkdir(parents=True, exist_ok=True)
     (out / "sweep.yaml").write_text(yaml.safe_dump(sweep_doc(team_sizes, seed, duration_s), sort_keys=False))
     result = run_sweep(load_sweep(out / "sweep.yaml"), out / "results", workers=None if scheduler else workers,
-                       scheduler=scheduler, plots=False, progress=lambda done, total, spec, record: spec and print(
-                           f"  [{done}/{total}] {spec.run_id} {record['status']}", file=sys.stderr, flush=True))
+                       scheduler=scheduler, plots=False, progress=_progress)
     rows = []
     for n, row in zip(team_sizes, result.table.itertuples()):
         report = out / "results" / "runs" / row.run_id / "report.json"

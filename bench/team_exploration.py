@@ -185,7 +185,8 @@ def run_sweep(worlds: dict[str, dict], methods: list[str], seeds: list[int], dur
         distance = sum(_number(row, f"robots.uav{i + 1}.distance_m") or 0.0 for i in range(METHODS[method][3]))
         scored = _number(row, "artifacts.scored")
         runs.append(Run(world, method, int(row["seed"]), _number(row, f"coverage_reached_s.{TARGET}"),
-                        _number(row, f"base_coverage_reached_s.{TARGET}"), float(row["coverage_fraction"]), float(row["base_coverage_fraction"]), distance,
+                        _number(row, f"base_coverage_reached_s.{TARGET}"), float(row["coverage_fraction"]),
+                        float(row["base_coverage_fraction"]), distance,
                         _number(row, "overlap_fraction"), None if scored is None else int(scored),
                         bool(row["succeeded"]), float(row["wall_time_s"])))
     return runs

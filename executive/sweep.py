@@ -29,7 +29,7 @@ CONNECT_TIMEOUT_S = 10
 INTERRUPTED = 130
 #: ``progress(done, total, spec, record)``: before the first run (0, total, None, None),
 #: then once per finished run.
-Progress = Callable[[int, int, "RunSpec | None", "dict | None"], None]
+ProgressFn = Callable[[int, int, "RunSpec | None", "dict | None"], None]
 
 
 @dataclass
@@ -82,7 +82,7 @@ def _quiet_on_interrupt() -> Iterator[None]:
 
 
 def run_sweep(sweep: Sweep, out: Path, *, workers: int | None = None, scheduler: str | None = None,
-              retry_failed: bool = False, progress: Progress | None = None, plots: bool = True) -> SweepResult:
+              retry_failed: bool = False, progress: ProgressFn | None = None, plots: bool = True) -> SweepResult:
     """Run every run of ``sweep`` not yet finished in ``out`` (failed ones too with
     ``retry_failed``), then write the table and (with ``plots``) the plots.
     ``progress(done, total, spec, record)`` is called once before the first run (0,
@@ -123,7 +123,7 @@ def run_sweep(sweep: Sweep, out: Path, *, workers: int | None = None, scheduler:
 
 
 @contextmanager
-def progress_bar(name: str) -> Iterator[Progress]:
+def progress_bar(name: str) -> Iterator[ProgressFn]:
     """A progress bar on stderr that counts finished runs (of those to run now), with
     a line per run."""
     from rich.console import Console

@@ -146,14 +146,16 @@ class GoTo(PathMotion):
 
     def _path(self, grid: Any) -> tuple[np.ndarray | None, str, str, str]:
         """(path, source, failure code, reason): the planners of ``planner`` in turn,
-        the first path found."""
-        code, why = "", ""
+        the first path found; when none finds one, ``invalid_start`` if the robot is
+        off its navigation graph, else ``no_path``, with every planner's reason."""
+        codes, why = [], ""
         for source in PLANNERS[self.p["planner"]]:
             path, code, reason = self._gbplanner_path(grid) if source == "gbplanner2" else self._navigator_path()
             if path is not None:
                 return path, source, "", ""
+            codes.append(code)
             why += ("; " if why else "") + reason
-        return None, "", code, why
+        return None, "", "invalid_start" if "invalid_start" in codes else "no_path", why
 
     def _gbplanner_path(self, grid: Any) -> tuple[np.ndarray | None, str, str]:
         """(path, failure code, reason) on GBPlanner2's global graph."""

@@ -6,7 +6,7 @@ re-check, 26-connected clusters, f_min), ``global_graph`` (G_C), ``reposition`` 
 target, path and box for a calling robot) and ``hub`` (the hub's state, tying them).
 """
 from .common_map import CommonMap, align_submap
-from .frontiers import GlobalFrontiers, cluster_frontiers, near_surface, recheck, submap_frontier
+from .frontiers import GlobalFrontiers, cluster_frontiers, map_frontier, near_surface, recheck, submap_frontier
 from .global_graph import GlobalGraph, segments_free, submap_rng, thin_trajectory
 from .hub import HOME, AssignmentRecord, CohortHub, SubmapInfo
 from .params import CohortParams
@@ -26,6 +26,7 @@ __all__ = [
     "choose_frontier",
     "cluster_frontiers",
     "exploration_box",
+    "map_frontier",
     "near_surface",
     "recheck",
     "segments_free",

@@ -113,6 +113,16 @@ def recheck(common: CommonMap, points: np.ndarray) -> np.ndarray:
     return points[~near_surface(common, points)]
 
 
+def map_frontier(common: CommonMap) -> np.ndarray:
+    """The frontier points of the whole common map, as :func:`recheck` keeps them:
+    every UNKNOWN block next to a FREE one (face neighbours), outside the surface band,
+    without the submaps' search from the trajectory. Looser than the points the hub
+    keeps, for confirming that the map is closed (flat indices, ascending)."""
+    occ = common.occupancy
+    wave = ndimage.binary_dilation(occ == FREE, structure=FACE_STRUCTURE) & (occ == UNKNOWN)
+    return recheck(common, np.flatnonzero(wave).astype(np.int64))
+
+
 def cluster_frontiers(common: CommonMap, points: np.ndarray, f_min: int) -> list[FrontierCluster]:
     """Frontier clusters: the 26-connected components of ``points`` (flat indices of
     the common map) with at least ``f_min`` points, largest first (ties: lowest first

@@ -17,7 +17,7 @@ import numpy as np
 from ..frontier import FrontierCluster
 from ..occupancy import FREE, Grid
 from .common_map import CommonMap, align_submap
-from .frontiers import GlobalFrontiers, cluster_frontiers, submap_frontier
+from .frontiers import GlobalFrontiers, cluster_frontiers, map_frontier, submap_frontier
 from .global_graph import GlobalGraph, submap_rng
 from .params import CohortParams
 from .reposition import Reposition, choose_frontier
@@ -172,11 +172,14 @@ class CohortHub:
 
     @property
     def explored(self) -> bool:
-        """Whether the common map is closed: submaps came, and not one frontier point
-        (of any cluster size) is left in it. Whatever a robot still out of reach finds
-        joins the map through ground the team's submaps showed open, so a closed
-        common map is the team's whole world. (Frontiers under f_min keep it open.)"""
-        return bool(self.submaps) and not len(self.frontiers.all_points())
+        """Whether the common map is closed: submaps came, not one frontier point (of
+        any cluster size) is left, and the whole map confirms it (:func:`map_frontier`:
+        the submaps' search from the trajectory, and the re-check, may have dropped a
+        point of an opening for good). Whatever a robot still out of reach finds joins
+        the map through ground the team's submaps showed open, so a closed common map
+        is the team's whole world. (Frontiers under f_min keep it open.)"""
+        return (bool(self.submaps) and not len(self.frontiers.all_points())
+                and not len(map_frontier(self.common)))
 
     def told_none(self, robot: str, t_s: float) -> bool:
         """Whether ``robot``'s latest answer, given less than T_C before ``t_s``, had no

@@ -126,9 +126,10 @@ class CallHub(Skill):
     ``exploration_bbox`` (the box D around the frontier); without one (the hub has
     nothing to give) those are null and the box is lifted, so that GBPlanner2 explores
     on its own. ``cohort_explored`` says whether the hub answered that its common map
-    has no frontier left (reason ``explored``): the team's exploration is over. A frontier within ``repeat_radius_m`` of the last target, when the
-    robot found that box explored (``exploration_complete``), counts as none (reason
-    ``repeated``): the hub's frontier is one the robot's sensors cannot clear. A call
+    has no frontier left (reason ``explored``): the team's exploration is over. A
+    frontier within ``repeat_radius_m`` of the last target, when the robot found that
+    box explored (``exploration_complete``), counts as none (reason ``repeated``): the
+    hub's frontier is one the robot's sensors cannot clear. A call
     that fails sets ``cohort_goal`` to null (nothing to follow) and keeps the box.
 
     Logs ``cohort_call`` (reached or not) and ``cohort_assignment_received``.

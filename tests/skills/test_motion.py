@@ -81,11 +81,12 @@ def test_goto_without_a_goal_fails(tunnel):
     assert node.get(node.keys["goto_failure"]) == "no_goal"
 
 
-def test_goto_from_a_pose_off_the_map_is_an_invalid_start(tunnel):
+@pytest.mark.parametrize("planner", ["navigator", "gbplanner", "navigator_or_gbplanner"])
+def test_goto_from_a_pose_off_the_map_is_an_invalid_start(tunnel, planner):
     grid, a, _ = tunnel
     robot = FakeRobot(grid, body(a, 10.0, 4.5))  # inside the rock, 2.5 m from the tunnel
     ctx = make_ctx(robot)
-    node = GoTo(name="Go", ctx=ctx, goal=body(a, 15.0).tolist())
+    node = GoTo(name="Go", ctx=ctx, goal=body(a, 15.0).tolist(), planner=planner)
     assert run(node, ctx, robot) == Status.FAILURE
     assert node.get(node.keys["goto_failure"]) == "invalid_start"
 

@@ -1,7 +1,8 @@
 """delve.planners.cohort.frontiers: submap wavefronts, the re-check against the common
 map, 26-connected clusters and f_min."""
 import numpy as np
-from delve.planners.cohort import CommonMap, GlobalFrontiers, cluster_frontiers, recheck, submap_frontier
+from delve.planners.cohort import (CommonMap, GlobalFrontiers, cluster_frontiers, map_frontier, recheck,
+                                   submap_frontier)
 from delve.planners.cohort.frontiers import near_surface
 from delve.planners.occupancy import FREE, OCCUPIED, UNKNOWN
 
@@ -80,3 +81,14 @@ def test_a_point_next_to_known_rock_is_in_the_surface_band_and_dropped():
     assert list(recheck(common, points)) == [points[2]]
     common.occupancy[7, 7, 5] = FREE                                     # mapped since: deleted as well
     assert len(recheck(common, points)) == 0
+
+
+def test_the_whole_maps_frontier_is_the_open_end_and_none_once_every_dead_end_is_seen():
+    truth = fork()
+    common = common_of(truth)
+    points, _, _ = add(common, truth, 0, 20, np.array([[3, 20, Z], [18, 20, Z]]))
+    whole = map_frontier(common)
+    assert len(whole) and np.all(np.abs(common.centres(whole)[:, 0] - 20.2) < 0.3)   # the trunk's end face
+    assert set(recheck(common, points)) <= set(whole)
+    add(common, truth, 20, 60)
+    assert len(map_frontier(common)) == 0

@@ -67,6 +67,9 @@ def test_a_closed_common_map_is_explored_and_one_with_small_frontiers_is_not():
     hub, fine = hub_after(whole)
     r = hub.reposition(fine, "a", np.array([30, 20, Z]), 10.0)
     assert hub.explored and r.reason == "explored" and r.frontier is None
+    hub, fine = hub_after(TRUNK)
+    hub.frontiers.points.clear()   # a frontier lost to the hub's filters: the map itself is still open
+    assert not hub.explored and hub.reposition(fine, "a", np.array([18, 20, Z]), 10.0).reason == "no_frontier"
     big = CohortParams(f_min=10_000)   # the trunk's end face stays open, under f_min
     hub, fine = hub_after(TRUNK)
     hub.params = big
