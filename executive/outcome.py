@@ -40,7 +40,7 @@ MIN_PROGRESS_FRACTION = 0.02
 MUCH_LEFT_FRACTION = 0.10
 #: Events that end a robot's exploration, well or not.
 EXPLORATION_ENDS = ("explore_failed", "exploration_complete", "planner_homing", "endurance_low",
-                    "homing_timer")
+                    "homing_timer", "exploration_over")
 
 
 @dataclass(frozen=True)

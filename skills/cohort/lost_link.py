@@ -57,11 +57,16 @@ class ExplorationOver(Skill):
     the end: the hub gives the next one), or the hub answered that its common map has
     no frontier left (the team explored its world).
 
+    With ``after_box: false`` GBPlanner2's "nothing left" does not count: at the start
+    of a cycle it may be a box's end, and the box was just lifted.
+
     Reads ``homing_due``, ``exploration_complete``, ``exploration_bbox`` and
-    ``cohort_explored``. Returns SUCCESS when over, else FAILURE.
+    ``cohort_explored``. Returns SUCCESS when over (logging ``exploration_over`` with
+    why), else FAILURE.
     """
 
     AGENT = None
+    PARAMS = {"after_box": Param(bool, True, "GBPlanner2's 'nothing left' with no box counts as over")}
     INPUT_PORTS = {
         "homing_due": PortInformation(bool, required=False, description="GBPlanner2 calls for homing"),
         "exploration_complete": PortInformation(bool, required=False, description="GBPlanner2 found nothing left"),
@@ -71,10 +76,17 @@ class ExplorationOver(Skill):
     }
 
     def update(self) -> Status:
-        if self.read("homing_due") or self.read("cohort_explored") or (
-                self.read("exploration_complete") and self.read("exploration_bbox") is None):
-            return Status.SUCCESS
-        return Status.FAILURE
+        if self.read("homing_due"):
+            why = "homing due"
+        elif self.read("cohort_explored"):
+            why = "the hub's common map has no frontier left"
+        elif self.p["after_box"] and self.read("exploration_complete") and self.read("exploration_bbox") is None:
+            why = "nothing left to explore, no box"
+        else:
+            return Status.FAILURE
+        self.feedback_message = why
+        self.event("exploration_over", why=why)
+        return Status.SUCCESS
 
 
 class ReturnToLinkPoint(GoTo):

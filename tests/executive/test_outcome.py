@@ -102,8 +102,9 @@ def test_a_success_after_a_failed_exploration_has_a_note():
     assert out.succeeded
     assert out.notes == ("a: SUCCESS, but its exploration ended with explore_failed: error, "
                          "InjectedPlannerError: x",)
-    later = events + [{"event": "exploration_complete", "agent": "a"}]
-    assert mission_outcome(mission({"a": Status.SUCCESS}, {"a": 50.0}, events=later)).notes == ()
+    for end in ("exploration_complete", "exploration_over"):   # a later end: the failure was recovered from
+        later = events + [{"event": end, "agent": "a"}]
+        assert mission_outcome(mission({"a": Status.SUCCESS}, {"a": 50.0}, events=later)).notes == ()
 
 
 def test_cops_judges_the_base_station_too():

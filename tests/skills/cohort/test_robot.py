@@ -271,6 +271,10 @@ def test_exploration_over(robot, homing, complete, box, explored, over):
     node = ExplorationOver(name="Over?", ctx=ctx)
     node.tick_once()
     assert node.status == (Status.SUCCESS if over else Status.FAILURE)
+    assert len(events(ctx, "exploration_over")) == over
+    start = ExplorationOver(name="Over yet?", ctx=ctx, after_box=False)   # a box's end does not count
+    start.tick_once()
+    assert start.status == (Status.SUCCESS if homing or explored else Status.FAILURE)
 
 
 # ----------------------------------------------------------------- ReturnToLinkPoint
