@@ -94,14 +94,30 @@ class Cohort(TeamStrategy):
 
     @classmethod
     def check_world(cls, scenario: "Scenario", world: Any) -> None:
+        """The team keys that only the world can judge: ``box_m`` and ``resolution_m``."""
+        team = scenario.doc.get("team")
+        if team is not None and "box_m" in team and hasattr(world, "bounds_max"):
+            cls._check_box(scenario, world, team)
+        if team is not None and "resolution_m" in team and hasattr(world, "voxel_size_m"):
+            cls._check_resolution(scenario, world, team)
+
+    @staticmethod
+    def _check_resolution(scenario: "Scenario", world: Any, team: Any) -> None:
+        """r_C is the nearest multiple of the world's voxel (the common map pools whole
+        voxels); one under half a voxel has none: a mistake."""
+        v, r_c = float(world.voxel_size_m), float(team["resolution_m"])
+        if r_c < 0.5 * v:
+            raise DelveError(f"team: resolution_m {r_c:g} m is finer than the world's voxels ({v:g} m): the common "
+                             f"map pools whole voxels; give at least {v:g} or leave it out", scenario.path,
+                             team.key_line("resolution_m"))
+
+    @staticmethod
+    def _check_box(scenario: "Scenario", world: Any, team: Any) -> None:
         """A ``box_m`` given in the scenario that is at least twice the world's size
         along every axis covers the whole world wherever the hub centres it (on a
         frontier inside the world), so it restricts nothing: a mistake (the paper's
         default is not checked). A smaller box, even one larger than the world, keeps a
         robot near a frontier off-centre."""
-        team = scenario.doc.get("team")
-        if team is None or "box_m" not in team or not hasattr(world, "bounds_max"):
-            return
         extent = np.asarray(world.bounds_max, float) - np.asarray(world.bounds_min, float)
         box = np.asarray(team["box_m"], float)
         if np.all(box >= 2.0 * extent):
