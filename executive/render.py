@@ -85,7 +85,9 @@ def _dot_names(root: Behaviour) -> Iterator[tuple[Behaviour, str]]:
 
 def dot_graph(root: Behaviour, statuses: Statuses | None = None) -> pydot.Dot:
     """``py_trees.display.dot_tree`` of the tree, each ticked node's border coloured by
-    its status (or the one ``statuses`` gives), with a legend."""
+    its status (or the one ``statuses`` gives), with a legend. A node whose name another
+    has too is labelled by its own name (dot_tree labels it by its unique graph name, the
+    name with ``*`` added)."""
     graph = py_trees.display.dot_tree(root)
     ticked = False
     with _showing(root, statuses):
@@ -94,6 +96,9 @@ def dot_graph(root: Behaviour, statuses: Statuses | None = None) -> pydot.Dot:
             # pydot's own name for it (a ':' starts a port); 'node', 'graph' and 'edge' name
             # the graph's defaults there, not a node.
             found = [] if name in ("node", "graph", "edge") else graph.get_node(pydot.Node(name).get_name())
+            label = found[0].get("label") if found else None
+            if name != node.name and isinstance(label, str):
+                found[0].set("label", label.replace(name, node.name, 1))
             if colour and found:
                 found[0].set("color", colour)
                 found[0].set("penwidth", "3")

@@ -90,6 +90,14 @@ def test_the_graph_colours_each_ticked_node_by_its_status(running_tree, ticked_t
     assert border(stopped, "Wait 10 s") is None and stopped.get("label") is None
 
 
+def test_nodes_of_one_name_are_labelled_by_it_not_by_their_unique_graph_names():
+    root = py_trees.composites.Sequence("Root", memory=True, children=[
+        py_trees.behaviours.Success("Explore from here"), py_trees.behaviours.Success("Explore from here")])
+    graph = dot_graph(root)
+    labels = [n.get("label") for n in graph.get_nodes() if n.get_name().strip('"').startswith("Explore from here")]
+    assert len(labels) == 2 and all(label.strip('"') == "Explore from here" for label in labels)
+
+
 def test_dot_is_written_without_graphviz(ticked_tree, tmp_path):
     out = render_tree(ticked_tree, "dot", tmp_path / "sub" / "tree.dot")
     text = out.read_text()
