@@ -146,6 +146,16 @@ class CohortHub:
             self.update_frontiers()
         self.robot_positions[robot] = np.asarray(position, float).copy()
         self.last_heard_s[robot] = float(t_s)
+        result = Reposition(None, reason="explored") if self.explored else self._choose(fine, robot, t_s)
+        points = self.clusters[result.cluster].voxels if result.ok else np.zeros(0, dtype=np.int64)
+        record = AssignmentRecord(robot, float(t_s), int(request_id), result, points)
+        self.assignments.append(record)
+        self.last_assignment[robot] = record
+        return result
+
+    def _choose(self, fine: Grid, robot: str, t_s: float) -> Reposition:
+        """:func:`choose_frontier` for ``robot`` with the sources, holders and free robots
+        that :meth:`reposition` describes."""
         radius = self.params.edge_radius_m
         sources = dict(sorted(self.robot_positions.items()))
         if self.home is not None:
@@ -158,17 +168,9 @@ class CohortHub:
                 if n not in (robot, HOME) and n not in busy and t_s - heard <= hold
                 and not self.told_none(n, t_s)]
         lo, hi = self.common.bounds
-        if self.explored:
-            result = Reposition(None, reason="explored")
-        else:
-            result = choose_frontier(self.graph, self.clusters, self.links, entries, robot,
-                                     best_share_pct=self.params.best_share_pct, box_m=self.params.box_m,
-                                     world_min=lo, world_max=hi, holders=holders, free=free)
-        points = self.clusters[result.cluster].voxels if result.ok else np.zeros(0, dtype=np.int64)
-        record = AssignmentRecord(robot, float(t_s), int(request_id), result, points)
-        self.assignments.append(record)
-        self.last_assignment[robot] = record
-        return result
+        return choose_frontier(self.graph, self.clusters, self.links, entries, robot,
+                               best_share_pct=self.params.best_share_pct, box_m=self.params.box_m,
+                               world_min=lo, world_max=hi, holders=holders, free=free)
 
     @property
     def explored(self) -> bool:
